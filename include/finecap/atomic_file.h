@@ -1,0 +1,21 @@
+// Output files are written under a temporary name in the same folder and renamed into place, so
+// an interrupted run never leaves a half-written file under the real name.
+#ifndef FINECAP_ATOMIC_FILE_H_
+#define FINECAP_ATOMIC_FILE_H_
+
+#include <functional>
+#include <string>
+
+namespace finecap {
+
+// Calls `write(temporary_path)`, then renames the temporary file to `path`. If `write` throws,
+// the temporary file is removed and the exception propagates; `path` is untouched.
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(const std::string& temporary_path)>& write);
+
+// Writes `contents` to `path` atomically. Throws Error naming the path on failure.
+void WriteTextFileAtomically(const std::string& path, const std::string& contents);
+
+}  // namespace finecap
+
+#endif  // FINECAP_ATOMIC_FILE_H_

@@ -1,0 +1,69 @@
+#include "finecap/camera.h"
+
+#include <cmath>
+
+#include <Eigen/LU>
+
+#include "finecap/error.h"
+
+namespace finecap {
+
+bool Camera::HasDistortion() const {
+  for (double coefficient : distortion) {
+    if (coefficient != 0.0) return true;
+  }
+  return false;
+}
+
+Camera Camera::Undistorted() const {
+  Camera camera = *this;
+  camera.distortion.fill(0.0);
+  return camera;
+}
+
+Eigen::Vector2d Camera::Project(const Eigen::Vector3d& world,
+                                Eigen::Matrix<double, 2, 3>* jacobian) const {
+  const Eigen::Vector3d p = ToCamera(world);
+  const double inv_z = 1.0 / p.z();
+  const double x = p.x() * inv_z;
+  const double y = p.y() * inv_z;
+  const auto [k1, k2, p1, p2, k3] = distortion;
+
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  const Eigen::Vector2d pixel(K(0, 0) * xd + K(0, 1) * yd + K(0, 2), K(1, 1) * yd + K(1, 2));
+  if (jacobian == nullptr) return pixel;
+
+  // Chain rule: pixel <- distorted <- normalised <- camera point <- world point.
+  const double dradial_dr2 = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);
+  Eigen::Matrix2d d_distorted_d_normalised;
+  d_distorted_d_normalised(0, 0) = radial + 2.0 * x * x * dradial_dr2 + 2.0 * p1 * y + 6.0 * p2 * x;
+  d_distorted_d_normalised(0, 1) = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
+  d_distorted_d_normalised(1, 0) = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
+  d_distorted_d_normalised(1, 1) = radial + 2.0 * y * y * dradial_dr2 + 6.0 * p1 * y + 2.0 * p2 * x;
+  Eigen::Matrix<double, 2, 3> d_normalised_d_camera;
+  d_normalised_d_camera << inv_z, 0.0, -x * inv_z, 0.0, inv_z, -y * inv_z;
+  Eigen::Matrix2d d_pixel_d_distorted;
+  d_pixel_d_distorted << K(0, 0), K(0, 1), 0.0, K(1, 1);
+  *jacobian = d_pixel_d_distorted * d_distorted_d_normalised * d_normalised_d_camera * R;
+  return pixel;
+}
+
+void Camera::Validate(const std::string& where) const {
+  const std::string at = where + " (camera '" + name + "')";
+  Require(width > 0 && height > 0, at, "image size must be positive");
+  Require(K.allFinite() && R.allFinite() && t.allFinite(), at, "non-finite value in K, R or t");
+  for (double coefficient : distortion) {
+    Require(std::isfinite(coefficient), at, "non-finite distortion coefficient");
+  }
+  Require(K(0, 0) > 0.0 && K(1, 1) > 0.0, at, "focal lengths must be positive");
+  Require(K(1, 0) == 0.0 && K(2, 0) == 0.0 && K(2, 1) == 0.0 && K(2, 2) == 1.0, at,
+          "K must be upper triangular with K(2,2) = 1");
+  const double orthonormality = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
+  Require(orthonormality < 1e-6 && std::abs(R.determinant() - 1.0) < 1e-6, at,
+          "R is not a rotation matrix (singular, scaled or reflecting)");
+}
+
+}  // namespace finecap
