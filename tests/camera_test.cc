@@ -18,7 +18,8 @@ Camera MakeDistortedCamera() {
   camera.width = 1004;
   camera.height = 1004;
   camera.K << 1200.0, 0.0, 501.5, 0.0, 1180.0, 498.0, 0.0, 0.0, 1.0;
-  camera.R = Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, -0.1).normalized()).toRotationMatrix();
+  camera.R =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, -0.1).normalized()).toRotationMatrix();
   camera.t = Eigen::Vector3d(0.1, -0.2, 3.0);
   camera.distortion = {-0.21, 0.08, 0.001, -0.002, 0.01};
   return camera;
@@ -29,7 +30,8 @@ TEST(CameraTest, ProjectionMatchesOpenCv) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> coordinate(-0.5, 0.5);
   std::vector<cv::Point3d> points;
-  for (int i = 0; i < 50; ++i) points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
+  for (int i = 0; i < 50; ++i)
+    points.emplace_back(coordinate(rng), coordinate(rng), coordinate(rng));
 
   cv::Mat rvec, K, R;
   cv::eigen2cv(camera.R, R);

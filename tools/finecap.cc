@@ -1,2 +1,169 @@
-// Placeholder entry point; replaced by the subcommand table.
-int main() { return 0; }
+// finecap: fine-scale surface detail for multi-view performance capture.
+//
+//   finecap <subcommand> [--config FILE] [flags]
+//
+// Parameters live in a YAML config; flags override single keys. Each subcommand is one row of
+// kSubcommands below; `finecap --help` and `finecap <subcommand> --help` describe everything.
+#include <cstdio>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "finecap/commands.h"
+#include "finecap/config.h"
+#include "finecap/error.h"
+
+DECLARE_bool(help);
+
+DEFINE_string(config, "", "YAML config file; every key is listed by `finecap --help`.");
+DEFINE_string(capture, "", "Capture folder; overrides capture.dir.");
+DEFINE_string(out, "", "Output folder; overrides output.dir.");
+DEFINE_string(frames, "", "Frames to process, A:B (indices A..B-1); overrides capture.frames.");
+DEFINE_int32(threads, -1, "Worker threads (0 = all cores); overrides runtime.threads.");
+DEFINE_string(set, "",
+              "Overrides of any config keys, comma separated: "
+              "--set output.mesh_format=obj,runtime.threads=2");
+
+namespace finecap {
+namespace {
+
+struct Subcommand {
+  const char* name;
+  const char* summary;
+  const char* usage;
+  int (*run)(const Config& config);
+  std::vector<const char*> flags;  // The flags that mean something to this subcommand.
+};
+
+const std::vector<Subcommand>& Subcommands() {
+  static const std::vector<Subcommand> kSubcommands = {
+      {"refine",
+       "Refine the coarse meshes of a capture with fine surface detail.",
+       "finecap refine --config configs/demo.yaml [--frames A:B] [--capture DIR] [--out DIR]",
+       &RunRefine,
+       {"config", "capture", "out", "frames", "threads", "set"}},
+  };
+  return kSubcommands;
+}
+
+const Subcommand* FindSubcommand(const std::string& name) {
+  for (const Subcommand& subcommand : Subcommands()) {
+    if (name == subcommand.name) return &subcommand;
+  }
+  return nullptr;
+}
+
+std::string FlagHelp(const char* name) {
+  gflags::CommandLineFlagInfo info;
+  gflags::GetCommandLineFlagInfo(name, &info);
+  std::string text = "  --" + info.name + " (" + info.type + ")";
+  if (!info.default_value.empty() && info.default_value != "-1") {
+    text += " default " + info.default_value;
+  }
+  return text + "\n      " + info.description + "\n";
+}
+
+std::string ConfigKeysHelp() {
+  Config defaults;
+  return MakeConfigSchema(&defaults).HelpText();
+}
+
+void PrintMainHelp() {
+  std::string text = "finecap " FINECAP_VERSION
+                     ": fine-scale surface detail for multi-view performance capture.\n\n"
+                     "Usage: finecap <subcommand> [--config FILE] [flags]\n\nSubcommands:\n";
+  for (const Subcommand& subcommand : Subcommands()) {
+    text += "  " + std::string(subcommand.name) + "\n      " + subcommand.summary + "\n";
+  }
+  text += "\nFlags (a flag overrides its config key):\n";
+  for (const char* flag : {"config", "capture", "out", "frames", "threads", "set"}) {
+    text += FlagHelp(flag);
+  }
+  text += "\nConfig keys (YAML sections and keys; type, default, meaning):\n" + ConfigKeysHelp();
+  text += "\n`finecap <subcommand> --help` describes one subcommand.\n";
+  std::cout << text;
+}
+
+void PrintSubcommandHelp(const Subcommand& subcommand) {
+  std::string text =
+      std::string(subcommand.summary) + "\n\nUsage: " + subcommand.usage + "\n\nFlags:\n";
+  for (const char* flag : subcommand.flags) text += FlagHelp(flag);
+  text += "\nConfig keys:\n" + ConfigKeysHelp();
+  std::cout << text;
+}
+
+// Splits "a=1,b=2" into overrides; a value may not itself contain a comma.
+std::vector<ConfigOverride> ParseSetFlag(const std::string& text) {
+  std::vector<ConfigOverride> overrides;
+  size_t start = 0;
+  while (start < text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    const size_t equals = item.find('=');
+    Require(equals != std::string::npos && equals > 0, "--set",
+            "expected key=value, got '" + item + "'");
+    overrides.push_back({item.substr(0, equals), item.substr(equals + 1), "--set"});
+    start = comma + 1;
+  }
+  return overrides;
+}
+
+std::vector<ConfigOverride> FlagOverrides() {
+  std::vector<ConfigOverride> overrides;
+  if (!FLAGS_capture.empty()) overrides.push_back({"capture.dir", FLAGS_capture, "--capture"});
+  if (!FLAGS_out.empty()) overrides.push_back({"output.dir", FLAGS_out, "--out"});
+  if (!FLAGS_frames.empty()) overrides.push_back({"capture.frames", FLAGS_frames, "--frames"});
+  if (FLAGS_threads >= 0) {
+    overrides.push_back({"runtime.threads", std::to_string(FLAGS_threads), "--threads"});
+  }
+  for (ConfigOverride& override_value : ParseSetFlag(FLAGS_set)) {
+    overrides.push_back(std::move(override_value));
+  }
+  return overrides;
+}
+
+int Main(int argc, char** argv) {
+  gflags::SetVersionString(FINECAP_VERSION);
+  gflags::SetUsageMessage("finecap <subcommand> [--config FILE] [flags]; see finecap --help");
+  gflags::ParseCommandLineNonHelpFlags(&argc, &argv, /*remove_flags=*/true);
+  FLAGS_logtostderr = true;
+  google::InitGoogleLogging(argv[0]);
+
+  if (argc < 2) {
+    PrintMainHelp();
+    return FLAGS_help ? 0 : 2;
+  }
+  const Subcommand* subcommand = FindSubcommand(argv[1]);
+  if (subcommand == nullptr) {
+    std::cerr << "finecap: unknown subcommand '" << argv[1] << "' (see finecap --help)\n";
+    return 2;
+  }
+  if (FLAGS_help) {
+    PrintSubcommandHelp(*subcommand);
+    return 0;
+  }
+  if (argc > 2) {
+    std::cerr << "finecap " << subcommand->name << ": unexpected argument '" << argv[2]
+              << "' (see finecap " << subcommand->name << " --help)\n";
+    return 2;
+  }
+  const Config config = LoadConfig(FLAGS_config, FlagOverrides());
+  return subcommand->run(config);
+}
+
+}  // namespace
+}  // namespace finecap
+
+int main(int argc, char** argv) {
+  try {
+    return finecap::Main(argc, argv);
+  } catch (const finecap::Error& error) {
+    std::cerr << "finecap: error: " << error.what() << "\n";
+  } catch (const std::exception& error) {
+    std::cerr << "finecap: internal error: " << error.what() << "\n";
+  }
+  return 1;
+}

@@ -16,7 +16,7 @@ namespace finecap {
 
 struct Camera {
   std::string name;
-  int width = 0;   // Image size in pixels.
+  int width = 0;  // Image size in pixels.
   int height = 0;
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  // Intrinsics; K(0,1) is the skew.
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // World-to-camera rotation.

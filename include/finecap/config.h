@@ -1,0 +1,64 @@
+// finecap's configuration: every option of every stage, read from a YAML file and overridden from
+// the command line. Each section is the options struct of one stage; `MakeConfigSchema` binds them
+// to their YAML keys, with documentation and allowed ranges (see config_schema.h).
+#ifndef FINECAP_CONFIG_H_
+#define FINECAP_CONFIG_H_
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "finecap/config_schema.h"
+#include "finecap/frame_range.h"
+
+namespace finecap {
+
+// Where the input comes from.
+struct CaptureConfig {
+  // Capture folder (layout in the README). Relative paths are relative to the working directory.
+  std::string dir;
+  // Frames to process, "A:B" = indices A to B-1 of the sorted frame list; "" = all frames.
+  std::string frames;
+};
+
+// Where the results go.
+struct OutputConfig {
+  // Output folder; created if missing. Files already in it are never overwritten.
+  std::string dir;
+  // Format of the refined meshes: "ply" (binary) or "obj".
+  std::string mesh_format = "ply";
+};
+
+// How the work is run.
+struct RuntimeConfig {
+  // Worker threads for parallel stages; 0 = all cores.
+  int threads = 0;
+};
+
+struct Config {
+  CaptureConfig capture;
+  OutputConfig output;
+  RuntimeConfig runtime;
+
+  // Cross-key checks that a single key's range cannot express. Throws Error naming the keys.
+  void Check() const;
+  FrameRange frame_range() const { return ParseFrameRange(capture.frames, "capture.frames"); }
+};
+
+// Binds every config key to a field of `*config`, which must outlive the schema.
+ConfigSchema MakeConfigSchema(Config* config);
+
+// A key=value override from the command line; `source` names it in errors (e.g. "--set").
+struct ConfigOverride {
+  std::string key;
+  std::string value;
+  std::string source;
+};
+
+// Defaults, then `file` (unless empty), then the overrides in order; then Config::Check().
+// Throws Error naming the file (or override) and the key on any problem.
+Config LoadConfig(const std::string& file, const std::vector<ConfigOverride>& overrides);
+
+}  // namespace finecap
+
+#endif  // FINECAP_CONFIG_H_

@@ -1,0 +1,78 @@
+// A typed, documented schema of configuration keys, bound to the fields of options structs.
+//
+// Every key has a dot-separated path ("solver.max_iterations"), a type, a documentation line, an
+// allowed range or set of choices, and the field it writes. Reading a YAML file against the schema
+// refuses unknown keys, wrong types and out-of-range values with an Error naming the file and the
+// key path; an override ("key=value", from the command line) goes through the same checks. The
+// schema also prints itself, so `--help` and the README list every key with its default.
+#ifndef FINECAP_CONFIG_SCHEMA_H_
+#define FINECAP_CONFIG_SCHEMA_H_
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace YAML {
+class Node;
+}
+
+namespace finecap {
+
+class ConfigSchema {
+ public:
+  // Registers a key bound to `*field`, whose current value is the key's default. Numeric keys
+  // accept values in [min, max]; choice keys one of `choices`. A path must be unique.
+  void AddInt(const std::string& path, int* field, const std::string& doc,
+              int min = std::numeric_limits<int>::lowest(),
+              int max = std::numeric_limits<int>::max());
+  void AddDouble(const std::string& path, double* field, const std::string& doc,
+                 double min = std::numeric_limits<double>::lowest(),
+                 double max = std::numeric_limits<double>::max());
+  void AddBool(const std::string& path, bool* field, const std::string& doc);
+  void AddString(const std::string& path, std::string* field, const std::string& doc);
+  void AddChoice(const std::string& path, std::string* field, const std::string& doc,
+                 const std::vector<std::string>& choices);
+  void AddDoubleList(const std::string& path, std::vector<double>* field, const std::string& doc,
+                     double min = std::numeric_limits<double>::lowest(),
+                     double max = std::numeric_limits<double>::max());
+
+  // Reads a YAML file into the bound fields. Keys absent from the file keep their values.
+  void ReadFile(const std::string& file);
+  // Reads an already parsed document; `file` names it in errors.
+  void ReadNode(const YAML::Node& root, const std::string& file);
+  // Sets one key from text (YAML syntax for the value), e.g. Set("solver.max_iterations", "50").
+  // `source` names where the override came from, for errors (e.g. "--set").
+  void Set(const std::string& path, const std::string& value, const std::string& source);
+
+  bool Has(const std::string& path) const;
+  // The value of a key in YAML syntax, as it is now.
+  std::string ValueText(const std::string& path) const;
+
+  // One line per key below `prefix` ("" for all): path, type, default, range, documentation.
+  std::string HelpText(const std::string& prefix = "") const;
+  // A Markdown table of all keys, for the README.
+  std::string MarkdownTable() const;
+
+ private:
+  struct Key {
+    std::string path;
+    std::string type;   // "int", "float", "bool", "string", "choice", "list of float".
+    std::string range;  // Human-readable allowed values; may be empty.
+    std::string doc;
+    std::string default_text;
+    // Parses and checks a YAML value, then writes the field; throws Error(where, ...) on failure.
+    std::function<void(const YAML::Node& value, const std::string& where)> assign;
+    std::function<std::string()> current_text;
+  };
+
+  void AddKey(Key key);
+  const Key* Find(const std::string& path) const;
+  void ReadMapping(const YAML::Node& mapping, const std::string& prefix, const std::string& file);
+
+  std::vector<Key> keys_;
+};
+
+}  // namespace finecap
+
+#endif  // FINECAP_CONFIG_SCHEMA_H_

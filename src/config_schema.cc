@@ -1,0 +1,237 @@
+#include "finecap/config_schema.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "finecap/error.h"
+
+namespace finecap {
+namespace {
+
+std::string KeyWhere(const std::string& file, const std::string& path) {
+  return file + ": key '" + path + "'";
+}
+
+std::string Scalar(const YAML::Node& value, const std::string& where) {
+  Require(value.IsScalar(), where, "expected a single value, found a list or mapping");
+  return value.Scalar();
+}
+
+template <typename T>
+T Convert(const YAML::Node& value, const std::string& where, const std::string& type_name) {
+  const std::string text = Scalar(value, where);
+  try {
+    return value.as<T>();
+  } catch (const YAML::Exception&) {
+    throw Error(where, "expected " + type_name + ", got '" + text + "'");
+  }
+}
+
+template <typename T>
+std::string RangeText(T min, T max) {
+  const bool has_min = min != std::numeric_limits<T>::lowest();
+  const bool has_max = max != std::numeric_limits<T>::max();
+  std::ostringstream text;
+  if (has_min && has_max) {
+    text << "[" << min << ", " << max << "]";
+  } else if (has_min) {
+    text << ">= " << min;
+  } else if (has_max) {
+    text << "<= " << max;
+  }
+  return text.str();
+}
+
+template <typename T>
+void RequireInRange(T value, T min, T max, const std::string& where) {
+  Require(value >= min && value <= max, where,
+          "value " + YAML::Node(value).as<std::string>() + " is outside " + RangeText(min, max));
+}
+
+double ConvertDouble(const YAML::Node& value, const std::string& where) {
+  const double number = Convert<double>(value, where, "a number");
+  Require(std::isfinite(number), where, "value must be finite");
+  return number;
+}
+
+std::string Join(const std::vector<std::string>& items, const std::string& separator) {
+  std::string joined;
+  for (const std::string& item : items) joined += (joined.empty() ? "" : separator) + item;
+  return joined;
+}
+
+std::string DoubleListText(const std::vector<double>& values) {
+  std::ostringstream text;
+  text << "[";
+  for (size_t i = 0; i < values.size(); ++i) text << (i ? ", " : "") << values[i];
+  text << "]";
+  return text.str();
+}
+
+}  // namespace
+
+void ConfigSchema::AddKey(Key key) {
+  Require(Find(key.path) == nullptr, key.path, "config key registered twice");
+  key.default_text = key.current_text();
+  keys_.push_back(std::move(key));
+}
+
+const ConfigSchema::Key* ConfigSchema::Find(const std::string& path) const {
+  for (const Key& key : keys_) {
+    if (key.path == path) return &key;
+  }
+  return nullptr;
+}
+
+bool ConfigSchema::Has(const std::string& path) const { return Find(path) != nullptr; }
+
+void ConfigSchema::AddInt(const std::string& path, int* field, const std::string& doc, int min,
+                          int max) {
+  AddKey({path, "int", RangeText(min, max), doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            const int number = Convert<int>(value, where, "an integer");
+            RequireInRange(number, min, max, where);
+            *field = number;
+          },
+          [=] { return std::to_string(*field); }});
+}
+
+void ConfigSchema::AddDouble(const std::string& path, double* field, const std::string& doc,
+                             double min, double max) {
+  AddKey({path, "float", RangeText(min, max), doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            const double number = ConvertDouble(value, where);
+            RequireInRange(number, min, max, where);
+            *field = number;
+          },
+          [=] { return YAML::Node(*field).as<std::string>(); }});
+}
+
+void ConfigSchema::AddBool(const std::string& path, bool* field, const std::string& doc) {
+  AddKey({path, "bool", "true, false", doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            *field = Convert<bool>(value, where, "true or false");
+          },
+          [=] { return std::string(*field ? "true" : "false"); }});
+}
+
+void ConfigSchema::AddString(const std::string& path, std::string* field, const std::string& doc) {
+  AddKey({path, "string", "", doc, "",
+          [=](const YAML::Node& value, const std::string& where) { *field = Scalar(value, where); },
+          [=] { return *field; }});
+}
+
+void ConfigSchema::AddChoice(const std::string& path, std::string* field, const std::string& doc,
+                             const std::vector<std::string>& choices) {
+  AddKey({path, "choice", Join(choices, ", "), doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            const std::string text = Scalar(value, where);
+            bool known = false;
+            for (const std::string& choice : choices) known = known || choice == text;
+            Require(known, where, "'" + text + "' is not one of: " + Join(choices, ", "));
+            *field = text;
+          },
+          [=] { return *field; }});
+}
+
+void ConfigSchema::AddDoubleList(const std::string& path, std::vector<double>* field,
+                                 const std::string& doc, double min, double max) {
+  AddKey({path, "list of float", RangeText(min, max), doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            Require(value.IsSequence(), where, "expected a list such as [1, 2]");
+            std::vector<double> numbers;
+            for (const YAML::Node& item : value) {
+              numbers.push_back(ConvertDouble(item, where));
+              RequireInRange(numbers.back(), min, max, where);
+            }
+            *field = numbers;
+          },
+          [=] { return DoubleListText(*field); }});
+}
+
+void ConfigSchema::ReadFile(const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file);
+  } catch (const YAML::BadFile&) {
+    throw Error(file, "cannot open the config file");
+  } catch (const YAML::Exception& error) {
+    throw Error(file,
+                "malformed YAML at line " + std::to_string(error.mark.line + 1) + ": " + error.msg);
+  }
+  ReadNode(root, file);
+}
+
+void ConfigSchema::ReadNode(const YAML::Node& root, const std::string& file) {
+  if (root.IsNull()) return;  // An empty file changes nothing.
+  Require(root.IsMap(), file, "a config must be a mapping of sections to keys");
+  ReadMapping(root, "", file);
+}
+
+void ConfigSchema::ReadMapping(const YAML::Node& mapping, const std::string& prefix,
+                               const std::string& file) {
+  for (const auto& entry : mapping) {
+    const std::string path = prefix + entry.first.as<std::string>();
+    if (const Key* key = Find(path)) {
+      key->assign(entry.second, KeyWhere(file, path));
+      continue;
+    }
+    const bool is_section = entry.second.IsMap() || entry.second.IsNull();
+    bool section_known = false;
+    for (const Key& key : keys_)
+      section_known = section_known || key.path.rfind(path + ".", 0) == 0;
+    Require(is_section && section_known, KeyWhere(file, path),
+            "unknown key (`finecap --help` lists every key)");
+    if (entry.second.IsMap()) ReadMapping(entry.second, path + ".", file);
+  }
+}
+
+void ConfigSchema::Set(const std::string& path, const std::string& value,
+                       const std::string& source) {
+  const Key* key = Find(path);
+  Require(key != nullptr, KeyWhere(source, path), "unknown key (`finecap --help` lists every key)");
+  // Text keys take the value literally ("3:" is a frame range, not a YAML mapping).
+  if (key->type == "string" || key->type == "choice") {
+    key->assign(YAML::Node(value), KeyWhere(source, path));
+    return;
+  }
+  YAML::Node node;
+  try {
+    node = YAML::Load(value);
+  } catch (const YAML::Exception& error) {
+    throw Error(KeyWhere(source, path), "malformed value '" + value + "': " + error.msg);
+  }
+  key->assign(node, KeyWhere(source, path));
+}
+
+std::string ConfigSchema::ValueText(const std::string& path) const {
+  const Key* key = Find(path);
+  Require(key != nullptr, path, "unknown config key");
+  return key->current_text();
+}
+
+std::string ConfigSchema::HelpText(const std::string& prefix) const {
+  std::ostringstream text;
+  for (const Key& key : keys_) {
+    if (key.path.rfind(prefix, 0) != 0) continue;
+    text << "  " << key.path << " (" << key.type;
+    if (!key.range.empty()) text << " " << key.range;
+    text << ", default " << (key.default_text.empty() ? "\"\"" : key.default_text) << ")\n";
+    text << "      " << key.doc << "\n";
+  }
+  return text.str();
+}
+
+std::string ConfigSchema::MarkdownTable() const {
+  std::ostringstream text;
+  text << "| key | type | default | allowed | meaning |\n|---|---|---|---|---|\n";
+  for (const Key& key : keys_) {
+    text << "| `" << key.path << "` | " << key.type << " | `" << key.default_text << "` | "
+         << key.range << " | " << key.doc << " |\n";
+  }
+  return text.str();
+}
+
+}  // namespace finecap

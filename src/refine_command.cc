@@ -1,0 +1,4 @@
+namespace finecap {
+struct Config;
+int RunRefine(const Config&) { return 0; }
+}  // namespace finecap
