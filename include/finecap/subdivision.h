@@ -13,6 +13,8 @@
 //  * boundary edge (a, b): 1/2 * (a + b);
 //  * a vertex on more than two boundary edges (where two sheets touch at a point) and a vertex in
 //    no triangle keep their position.
+// Corners are not tagged: a boundary vertex where the boundary turns sharply is smoothed like any
+// other and rounds the corner (a closed hem, like a skirt's, has none).
 // Every row of S sums to 1, so the map is affine-invariant: planes stay planar.
 //
 // Vertex numbering, an invariant other code relies on: the first num_coarse_vertices fine
