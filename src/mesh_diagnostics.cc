@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include <Eigen/Geometry>
+
 #include "finecap/error.h"
 #include "finecap/mesh_edges.h"
 
