@@ -1,0 +1,162 @@
+#include "finecap/color.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "finecap/error.h"
+
+namespace finecap {
+namespace {
+
+constexpr float kInv255 = 1.0f / 255.0f;
+// Radius of the HSV cone's base: makes the chroma plane span [-0.5, 0.5]^2.
+constexpr double kHsvChromaRadius = 0.5;
+constexpr double kLabScale = 0.01;
+
+// The chroma-plane point (0.5 * C * cos, 0.5 * C * sin) of a hue 60 * d / C degrees from its
+// sector's base, for every 8-bit chroma C in [1, 255] and 0 <= d <= C. HSV's hue is the rational
+// d / C of two bytes, so a table of about 33k entries gives the exact embedding without
+// trigonometry per pixel; negative d and the sector's base are handled by symmetry and rotation.
+class HueTable {
+ public:
+  HueTable() : entries_(Index(255, 255) + 1) {
+    for (int chroma = 1; chroma <= 255; ++chroma) {
+      for (int d = 0; d <= chroma; ++d) {
+        const double angle = (M_PI / 3.0) * d / chroma;
+        const double radius = kHsvChromaRadius * chroma / 255.0;
+        entries_[Index(chroma, d)] = {static_cast<float>(radius * std::cos(angle)),
+                                      static_cast<float>(radius * std::sin(angle))};
+      }
+    }
+  }
+
+  // The point for chroma `chroma` in [1, 255] and signed offset `d` in [-chroma, chroma].
+  std::array<float, 2> Lookup(int chroma, int d) const {
+    const std::array<float, 2>& entry = entries_[Index(chroma, std::abs(d))];
+    return {entry[0], d < 0 ? -entry[1] : entry[1]};
+  }
+
+ private:
+  static int Index(int chroma, int d) { return chroma * (chroma + 1) / 2 + d; }
+
+  std::vector<std::array<float, 2>> entries_;
+};
+
+const HueTable& GetHueTable() {
+  static const HueTable table;
+  return table;
+}
+
+Eigen::Vector3f HsvCone(int b, int g, int r, const HueTable& table) {
+  const int max = std::max({b, g, r});
+  const int chroma = max - std::min({b, g, r});
+  const float value = max * kInv255;
+  if (chroma == 0) return Eigen::Vector3f(0.0f, 0.0f, value);
+
+  // Hexagonal hue: the sector is named by the largest channel (red 0, green 120, blue 240
+  // degrees), the offset inside it by the difference of the other two.
+  constexpr float kCos120 = -0.5f, kSin120 = 0.866025403784438647f;
+  float cos_base = 1.0f, sin_base = 0.0f;
+  int offset;
+  if (max == r) {
+    offset = g - b;
+  } else if (max == g) {
+    offset = b - r;
+    cos_base = kCos120;
+    sin_base = kSin120;
+  } else {
+    offset = r - g;
+    cos_base = kCos120;
+    sin_base = -kSin120;
+  }
+  const std::array<float, 2> p = table.Lookup(chroma, offset);
+  return Eigen::Vector3f(cos_base * p[0] - sin_base * p[1], sin_base * p[0] + cos_base * p[1],
+                         value);
+}
+
+cv::Mat ConvertToHsvCone(const cv::Mat& bgr) {
+  const HueTable& table = GetHueTable();
+  cv::Mat out(bgr.size(), CV_32FC3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* in_row = bgr.ptr<cv::Vec3b>(y);
+    cv::Vec3f* out_row = out.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const Eigen::Vector3f c = HsvCone(in_row[x][0], in_row[x][1], in_row[x][2], table);
+      out_row[x] = cv::Vec3f(c.x(), c.y(), c.z());
+    }
+  }
+  return out;
+}
+
+cv::Mat ConvertToNormalizedRgb(const cv::Mat& bgr) {
+  cv::Mat rgb, out;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  rgb.convertTo(out, CV_32FC3, kInv255);
+  return out;
+}
+
+cv::Mat ConvertToLab(const cv::Mat& bgr) {
+  // OpenCV's 8-bit Lab output is quantised to bytes; its float path keeps full precision.
+  cv::Mat unit_bgr, lab;
+  bgr.convertTo(unit_bgr, CV_32FC3, kInv255);
+  cv::cvtColor(unit_bgr, lab, cv::COLOR_BGR2Lab);
+  lab *= kLabScale;
+  return lab;
+}
+
+cv::Mat ConvertUnchecked(const cv::Mat& bgr, ColorSpace space) {
+  switch (space) {
+    case ColorSpace::kHsv:
+      return ConvertToHsvCone(bgr);
+    case ColorSpace::kNormalizedRgb:
+      return ConvertToNormalizedRgb(bgr);
+    case ColorSpace::kLab:
+      return ConvertToLab(bgr);
+  }
+  throw Error("", "unknown colour space");
+}
+
+}  // namespace
+
+std::string ColorSpaceName(ColorSpace space) {
+  switch (space) {
+    case ColorSpace::kHsv:
+      return "hsv";
+    case ColorSpace::kNormalizedRgb:
+      return "normalized_rgb";
+    case ColorSpace::kLab:
+      return "lab";
+  }
+  throw Error("", "unknown colour space");
+}
+
+ColorSpace ParseColorSpace(const std::string& name, const std::string& where) {
+  for (ColorSpace space : {ColorSpace::kHsv, ColorSpace::kNormalizedRgb, ColorSpace::kLab}) {
+    if (name == ColorSpaceName(space)) return space;
+  }
+  throw Error(where, "unknown colour space '" + name + "'; expected hsv, normalized_rgb or lab");
+}
+
+Eigen::Vector3f ConvertColor(const cv::Vec3b& bgr, ColorSpace space) {
+  if (space == ColorSpace::kHsv) return HsvCone(bgr[0], bgr[1], bgr[2], GetHueTable());
+  const cv::Mat converted = ConvertUnchecked(cv::Mat(1, 1, CV_8UC3, cv::Scalar(bgr)), space);
+  const cv::Vec3f c = converted.at<cv::Vec3f>(0, 0);
+  return Eigen::Vector3f(c[0], c[1], c[2]);
+}
+
+cv::Mat ConvertImage(const cv::Mat& bgr, ColorSpace space, const std::string& where) {
+  Require(!bgr.empty(), where, "image is empty");
+  Require(bgr.type() == CV_8UC3, where,
+          "expected an 8-bit 3-channel BGR image, got OpenCV type " + cv::typeToString(bgr.type()));
+  return ConvertUnchecked(bgr, space);
+}
+
+double ColorDistance(const Eigen::Vector3f& a, const Eigen::Vector3f& b, ColorSpace /*space*/) {
+  return static_cast<double>((a - b).norm());
+}
+
+}  // namespace finecap

@@ -1,0 +1,360 @@
+#include "finecap/image_gaussians.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+
+#include "finecap/error.h"
+
+namespace finecap {
+namespace {
+
+// Spread^2 below this counts as zero: the rounding error of the pyramid's sums is far smaller,
+// and the smallest real spread of 8-bit colours (one grey level in 2^20 pixels) far larger.
+constexpr double kSpreadSquaredTolerance = 1e-13;
+constexpr int kMaxRootSide = 1 << 20;
+
+// Sums over the foreground pixels of one quad-tree square.
+struct Moments {
+  double sum[3] = {0.0, 0.0, 0.0};  // Of the embedded colours.
+  double sum_squared = 0.0;         // Of the squared norms of the embedded colours.
+  int64_t count = 0;                // Of the pixels.
+
+  void Add(const Moments& other) {
+    for (int c = 0; c < 3; ++c) sum[c] += other.sum[c];
+    sum_squared += other.sum_squared;
+    count += other.count;
+  }
+
+  double SpreadSquared() const {
+    const double inv = 1.0 / static_cast<double>(count);
+    double mean_norm_squared = 0.0;
+    for (int c = 0; c < 3; ++c) mean_norm_squared += (sum[c] * inv) * (sum[c] * inv);
+    return sum_squared * inv - mean_norm_squared;
+  }
+};
+
+// One level of the moment pyramid: a grid of squares of equal side.
+struct MomentGrid {
+  int cols = 0;
+  int rows = 0;
+  std::vector<Moments> cells;
+
+  MomentGrid(int num_cols, int num_rows)
+      : cols(num_cols), rows(num_rows), cells(size_t(num_cols) * num_rows) {}
+  bool Contains(int col, int row) const { return col < cols && row < rows; }
+  Moments& at(int col, int row) { return cells[size_t(row) * cols + col]; }
+  const Moments& at(int col, int row) const { return cells[size_t(row) * cols + col]; }
+};
+
+int CeilDiv(int a, int b) { return (a + b - 1) / b; }
+
+// Level 0: the moments of the squares of side `side` tiling the image from (0, 0).
+MomentGrid SmallestSquareMoments(const cv::Mat& colors, const cv::Mat& mask, int side) {
+  MomentGrid grid(CeilDiv(colors.cols, side), CeilDiv(colors.rows, side));
+  for (int y = 0; y < colors.rows; ++y) {
+    const cv::Vec3f* color_row = colors.ptr<cv::Vec3f>(y);
+    const uint8_t* mask_row = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
+    Moments* cell_row = &grid.at(0, y / side);
+    for (int col = 0; col < grid.cols; ++col) {
+      Moments& cell = cell_row[col];
+      const int x_end = std::min(colors.cols, (col + 1) * side);
+      for (int x = col * side; x < x_end; ++x) {
+        if (mask_row != nullptr && mask_row[x] == 0) continue;
+        const cv::Vec3f& c = color_row[x];
+        cell.sum[0] += c[0];
+        cell.sum[1] += c[1];
+        cell.sum[2] += c[2];
+        cell.sum_squared += double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2];
+        ++cell.count;
+      }
+    }
+  }
+  return grid;
+}
+
+MomentGrid CoarserMoments(const MomentGrid& fine) {
+  MomentGrid coarse(CeilDiv(fine.cols, 2), CeilDiv(fine.rows, 2));
+  for (int row = 0; row < fine.rows; ++row) {
+    for (int col = 0; col < fine.cols; ++col) coarse.at(col / 2, row / 2).Add(fine.at(col, row));
+  }
+  return coarse;
+}
+
+// Walks the quad-tree top-down over the moment pyramid, emitting the leaves.
+class QuadTreeWalker {
+ public:
+  QuadTreeWalker(const std::vector<MomentGrid>& pyramid, const ImageGaussianOptions& options,
+                 std::vector<ImageGaussian>* leaves)
+      : pyramid_(pyramid),
+        min_side_(options.min_leaf_size),
+        max_spread_squared_(options.split_threshold * options.split_threshold +
+                            kSpreadSquaredTolerance),
+        leaves_(leaves) {}
+
+  void WalkAllRoots() {
+    const int top = static_cast<int>(pyramid_.size()) - 1;
+    for (int row = 0; row < pyramid_[top].rows; ++row) {
+      for (int col = 0; col < pyramid_[top].cols; ++col) Visit(top, col, row);
+    }
+  }
+
+ private:
+  void Visit(int level, int col, int row) {
+    const Moments& square = pyramid_[level].at(col, row);
+    if (square.count == 0) return;
+    const int side = min_side_ << level;
+    const int64_t area = int64_t(side) * side;
+    if (level == 0) {
+      if (2 * square.count >= area) Emit(square, col, row, side);
+      return;
+    }
+    if (square.count == area && square.SpreadSquared() <= max_spread_squared_) {
+      Emit(square, col, row, side);
+      return;
+    }
+    const MomentGrid& finer = pyramid_[level - 1];
+    for (int child_row = 2 * row; child_row <= 2 * row + 1; ++child_row) {
+      for (int child_col = 2 * col; child_col <= 2 * col + 1; ++child_col) {
+        if (finer.Contains(child_col, child_row)) Visit(level - 1, child_col, child_row);
+      }
+    }
+  }
+
+  void Emit(const Moments& square, int col, int row, int side) {
+    ImageGaussian leaf;
+    const double centre_offset = 0.5 * (side - 1);
+    leaf.x = static_cast<float>(double(col) * side + centre_offset);
+    leaf.y = static_cast<float>(double(row) * side + centre_offset);
+    leaf.sigma = 0.5f * side;
+    for (int c = 0; c < 3; ++c) leaf.color[c] = static_cast<float>(square.sum[c] / square.count);
+    leaves_->push_back(leaf);
+  }
+
+  const std::vector<MomentGrid>& pyramid_;
+  const int min_side_;
+  const double max_spread_squared_;
+  std::vector<ImageGaussian>* leaves_;
+};
+
+void CheckImageAndMask(const cv::Mat& image, const cv::Mat& mask, const std::string& where) {
+  Require(!image.empty(), where, "image is empty");
+  Require(image.type() == CV_8UC3 || image.type() == CV_32FC3, where,
+          "expected an 8-bit BGR image (CV_8UC3) or a converted colour image (CV_32FC3), got "
+          "OpenCV type " +
+              cv::typeToString(image.type()));
+  if (mask.empty()) return;
+  Require(mask.type() == CV_8UC1, where,
+          "expected an 8-bit single-channel mask (CV_8UC1), got OpenCV type " +
+              cv::typeToString(mask.type()));
+  Require(mask.size() == image.size(), where,
+          "mask is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) +
+              " pixels but the image is " + std::to_string(image.cols) + "x" +
+              std::to_string(image.rows));
+}
+
+ImageGaussians BuildChecked(const cv::Mat& image, const cv::Mat& mask,
+                            const ImageGaussianOptions& options, const std::string& where) {
+  const cv::Mat colors =
+      image.type() == CV_8UC3 ? ConvertImage(image, options.color_space, where) : image;
+  std::vector<MomentGrid> pyramid;
+  pyramid.reserve(options.max_depth + 1);
+  pyramid.push_back(SmallestSquareMoments(colors, mask, options.min_leaf_size));
+  for (int level = 1; level <= options.max_depth; ++level) {
+    pyramid.push_back(CoarserMoments(pyramid.back()));
+  }
+  std::vector<ImageGaussian> leaves;
+  leaves.reserve(pyramid[0].cells.size() / 4);
+  QuadTreeWalker(pyramid, options, &leaves).WalkAllRoots();
+  return ImageGaussians(image.cols, image.rows, options.color_space, std::move(leaves), where);
+}
+
+bool IsFinite(const ImageGaussian& g) {
+  return std::isfinite(g.x) && std::isfinite(g.y) && std::isfinite(g.color[0]) &&
+         std::isfinite(g.color[1]) && std::isfinite(g.color[2]);
+}
+
+// Size classes are the binary exponents of sigma: sigma in [2^k, 2^(k+1)).
+int SizeExponent(float sigma) { return std::ilogb(sigma); }
+
+}  // namespace
+
+void ImageGaussianOptions::Check() const {
+  const std::string where = "ImageGaussianOptions";
+  Require(max_depth >= 0 && max_depth <= 16, where + "::max_depth",
+          "must be in [0, 16], got " + std::to_string(max_depth));
+  Require(min_leaf_size >= 1, where + "::min_leaf_size",
+          "must be at least 1, got " + std::to_string(min_leaf_size));
+  Require(min_leaf_size <= (kMaxRootSide >> max_depth), where + "::min_leaf_size",
+          "min_leaf_size * 2^max_depth may not exceed 2^20, got " + std::to_string(min_leaf_size) +
+              " * 2^" + std::to_string(max_depth));
+  Require(std::isfinite(split_threshold) && split_threshold >= 0.0, where + "::split_threshold",
+          "must be finite and non-negative, got " + std::to_string(split_threshold));
+}
+
+ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
+                               std::vector<ImageGaussian> gaussians, const std::string& where)
+    : width_(width), height_(height), color_space_(color_space) {
+  Require(width >= 0 && height >= 0, where, "negative image size");
+  for (const ImageGaussian& g : gaussians) {
+    Require(IsFinite(g), where, "image Gaussian with a non-finite mean or colour");
+    Require(std::isfinite(g.sigma) && g.sigma > 0.0f, where,
+            "image Gaussian with sigma " + std::to_string(g.sigma) + "; must be positive");
+  }
+  if (gaussians.empty()) return;
+
+  // Group by size class, and inside a class by grid cell: a counting sort over (class, cell).
+  int min_exponent = SizeExponent(gaussians[0].sigma), max_exponent = min_exponent;
+  for (const ImageGaussian& g : gaussians) {
+    min_exponent = std::min(min_exponent, SizeExponent(g.sigma));
+    max_exponent = std::max(max_exponent, SizeExponent(g.sigma));
+  }
+  std::vector<std::vector<int>> members(max_exponent - min_exponent + 1);
+  for (int i = 0; i < static_cast<int>(gaussians.size()); ++i) {
+    members[SizeExponent(gaussians[i].sigma) - min_exponent].push_back(i);
+  }
+
+  gaussians_.reserve(gaussians.size());
+  for (int k = 0; k < static_cast<int>(members.size()); ++k) {
+    if (members[k].empty()) continue;
+    SizeClass size_class;
+    size_class.begin = static_cast<int>(gaussians_.size());
+    float min_x = gaussians[members[k][0]].x, max_x = min_x;
+    float min_y = gaussians[members[k][0]].y, max_y = min_y;
+    for (int i : members[k]) {
+      const ImageGaussian& g = gaussians[i];
+      size_class.max_sigma = std::max(size_class.max_sigma, g.sigma);
+      min_x = std::min(min_x, g.x);
+      max_x = std::max(max_x, g.x);
+      min_y = std::min(min_y, g.y);
+      max_y = std::max(max_y, g.y);
+    }
+    // A cell the side of the class's smallest square holds about one quad-tree leaf; a class
+    // that is sparse over its extent gets coarser cells, keeping the grid within ~4 cells per
+    // Gaussian.
+    const double max_cells = 4.0 * members[k].size() + 64.0;
+    size_class.cell = std::ldexp(1.0, min_exponent + k + 1);
+    while ((double(max_x - min_x) / size_class.cell + 1.0) *
+               (double(max_y - min_y) / size_class.cell + 1.0) >
+           max_cells) {
+      size_class.cell *= 2.0;
+    }
+    size_class.origin_x = min_x;
+    size_class.origin_y = min_y;
+    size_class.cols = static_cast<int>((max_x - min_x) / size_class.cell) + 1;
+    size_class.rows = static_cast<int>((max_y - min_y) / size_class.cell) + 1;
+
+    auto cell_of = [&size_class](const ImageGaussian& g) {
+      const int col = std::min(size_class.cols - 1,
+                               static_cast<int>((g.x - size_class.origin_x) / size_class.cell));
+      const int row = std::min(size_class.rows - 1,
+                               static_cast<int>((g.y - size_class.origin_y) / size_class.cell));
+      return row * size_class.cols + col;
+    };
+    const int num_cells = size_class.cols * size_class.rows;
+    std::vector<int> cell_count(num_cells + 1, 0);
+    for (int i : members[k]) ++cell_count[cell_of(gaussians[i]) + 1];
+    size_class.cell_begin.resize(num_cells + 1);
+    size_class.cell_begin[0] = size_class.begin;
+    for (int c = 0; c < num_cells; ++c) {
+      size_class.cell_begin[c + 1] = size_class.cell_begin[c] + cell_count[c + 1];
+    }
+    std::vector<int> next(size_class.cell_begin.begin(), size_class.cell_begin.end() - 1);
+    gaussians_.resize(gaussians_.size() + members[k].size());
+    for (int i : members[k]) gaussians_[next[cell_of(gaussians[i])]++] = gaussians[i];
+    classes_.push_back(std::move(size_class));
+  }
+}
+
+void ImageGaussians::CollectNear(const Eigen::Vector2d& point, double base, double sigma_factor,
+                                 std::vector<int>* indices) const {
+  for (const SizeClass& size_class : classes_) {
+    const double max_sigma = size_class.max_sigma;
+    const double radius_squared = base + sigma_factor * max_sigma * max_sigma;
+    if (!(radius_squared >= 0.0)) continue;
+    const double radius = std::sqrt(radius_squared);
+    // Cell ranges in double first: a far-away query must not overflow the int conversion.
+    const auto clamp_cell = [](double value, int count) {
+      return static_cast<int>(std::clamp(std::floor(value), -1.0, double(count)));
+    };
+    const int col_begin = std::max(
+        0,
+        clamp_cell((point.x() - radius - size_class.origin_x) / size_class.cell, size_class.cols));
+    const int col_last = std::min(
+        size_class.cols - 1,
+        clamp_cell((point.x() + radius - size_class.origin_x) / size_class.cell, size_class.cols));
+    const int row_begin = std::max(
+        0,
+        clamp_cell((point.y() - radius - size_class.origin_y) / size_class.cell, size_class.rows));
+    const int row_last = std::min(
+        size_class.rows - 1,
+        clamp_cell((point.y() + radius - size_class.origin_y) / size_class.cell, size_class.rows));
+    for (int row = row_begin; row <= row_last; ++row) {
+      // The cells of one grid row are contiguous in gaussians_.
+      const int begin = size_class.cell_begin[row * size_class.cols + col_begin];
+      const int end = size_class.cell_begin[row * size_class.cols + col_last + 1];
+      for (int i = begin; i < end; ++i) {
+        const ImageGaussian& g = gaussians_[i];
+        const double dx = g.x - point.x(), dy = g.y - point.y();
+        const double sigma = g.sigma;
+        if (dx * dx + dy * dy <= base + sigma_factor * sigma * sigma) indices->push_back(i);
+      }
+    }
+  }
+}
+
+void ImageGaussians::FindWithin(const Eigen::Vector2d& point, double radius,
+                                std::vector<int>* indices) const {
+  indices->clear();
+  if (radius >= 0.0) CollectNear(point, radius * radius, 0.0, indices);
+}
+
+void ImageGaussians::FindReaching(const Eigen::Vector2d& point, double sigma, double cutoff,
+                                  std::vector<int>* indices) const {
+  indices->clear();
+  const double cutoff_squared = cutoff * cutoff;
+  CollectNear(point, cutoff_squared * sigma * sigma, cutoff_squared, indices);
+}
+
+ImageGaussians BuildImageGaussians(const cv::Mat& image, const cv::Mat& mask,
+                                   const ImageGaussianOptions& options, const std::string& where) {
+  options.Check();
+  CheckImageAndMask(image, mask, where);
+  return BuildChecked(image, mask, options, where);
+}
+
+std::vector<ImageGaussians> BuildFrameImageGaussians(const std::vector<cv::Mat>& images,
+                                                     const std::vector<cv::Mat>& masks,
+                                                     const ImageGaussianOptions& options,
+                                                     const std::vector<std::string>& names) {
+  options.Check();
+  Require(names.size() == images.size(), "BuildFrameImageGaussians",
+          std::to_string(images.size()) + " images but " + std::to_string(names.size()) + " names");
+  Require(masks.empty() || masks.size() == images.size(), "BuildFrameImageGaussians",
+          std::to_string(images.size()) + " images but " + std::to_string(masks.size()) + " masks");
+  static const cv::Mat kNoMask;
+  const auto mask_of = [&masks](size_t i) -> const cv::Mat& {
+    return masks.empty() ? kNoMask : masks[i];
+  };
+  for (size_t i = 0; i < images.size(); ++i) CheckImageAndMask(images[i], mask_of(i), names[i]);
+
+  // Exceptions may not leave an OpenMP region: keep each, rethrow the first afterwards.
+  const int count = static_cast<int>(images.size());
+  std::vector<ImageGaussians> result(count);
+  std::vector<std::exception_ptr> failures(count);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int i = 0; i < count; ++i) {
+    try {
+      result[i] = BuildChecked(images[i], mask_of(i), options, names[i]);
+    } catch (...) {
+      failures[i] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
+  }
+  return result;
+}
+
+}  // namespace finecap

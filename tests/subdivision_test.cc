@@ -1,0 +1,267 @@
+#include "finecap/subdivision.h"
+
+#include <random>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "finecap/error.h"
+#include "finecap/mesh_edges.h"
+#include "test_meshes.h"
+
+namespace finecap {
+namespace {
+
+using testing_meshes::GridId;
+using testing_meshes::GridMesh;
+using testing_meshes::Icosahedron;
+using testing_meshes::TubeMesh;
+
+// Moves every vertex by a random offset, so that stencil weights show in the positions.
+Mesh Jittered(Mesh mesh, double amount, unsigned seed = 3) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> offset(-amount, amount);
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) mesh.vertices(axis, v) += offset(rng);
+  }
+  return mesh;
+}
+
+// The fine id of the edge point between coarse vertices a and b after one level.
+int EdgePoint(const SubdivisionStencil& stencil, int a, int b) {
+  const Eigen::Matrix2Xi& edges = stencil.level_edges.at(0);
+  for (int e = 0; e < edges.cols(); ++e) {
+    if (edges(0, e) == std::min(a, b) && edges(1, e) == std::max(a, b)) {
+      return stencil.num_coarse_vertices + e;
+    }
+  }
+  ADD_FAILURE() << "no edge " << a << "-" << b;
+  return 0;
+}
+
+TEST(SubdivisionTest, VertexAndFaceCountsGrowByEdgesAndFour) {
+  const Mesh ico = Icosahedron();
+  EXPECT_EQ(BuildLoopSubdivision(ico, 0).num_fine_vertices(), 12);
+  EXPECT_EQ(BuildLoopSubdivision(ico, 1).num_fine_vertices(), 12 + 30);
+  const SubdivisionStencil two = BuildLoopSubdivision(ico, 2);
+  EXPECT_EQ(two.num_fine_vertices(), 42 + 120);
+  EXPECT_EQ(two.faces.cols(), 320);
+  EXPECT_EQ(two.levels, 2);
+  // The tube: V = 8 * 4, E = 80 (rings, verticals, diagonals).
+  EXPECT_EQ(BuildLoopSubdivision(TubeMesh(8, 4), 1).num_fine_vertices(), 32 + 80);
+}
+
+TEST(SubdivisionTest, EveryRowSumsToOne) {
+  for (const Mesh& mesh : {Icosahedron(), TubeMesh(7, 5), GridMesh(4, 3)}) {
+    const SubdivisionStencil stencil = BuildLoopSubdivision(mesh, 2);
+    const Eigen::VectorXd sums = stencil.matrix * Eigen::VectorXd::Ones(mesh.num_vertices());
+    EXPECT_LT((sums.array() - 1.0).abs().maxCoeff(), 1e-12);
+    EXPECT_GE(stencil.matrix.coeffs().minCoeff(), 0.0);
+  }
+}
+
+TEST(SubdivisionTest, FirstFineVerticesAreTheCoarseOnesInOrder) {
+  const Mesh tube = Jittered(TubeMesh(6, 3), 0.05);
+  const SubdivisionStencil stencil = BuildLoopSubdivision(tube, 2);
+  EXPECT_EQ(stencil.FineVertexOfCoarse(5), 5);
+  EXPECT_THROW(stencil.FineVertexOfCoarse(18), Error);
+  // The fine faces use coarse vertex v exactly where the coarse faces did, at the corners.
+  const Mesh fine = ApplySubdivision(stencil, tube.vertices);
+  for (int v = 0; v < tube.num_vertices(); ++v) {
+    EXPECT_GT(stencil.matrix.coeff(v, v), 0.5);
+    EXPECT_LT((fine.vertices.col(v) - tube.vertices.col(v)).norm(), 0.2);
+  }
+}
+
+TEST(SubdivisionTest, RegularInteriorVertexAndEdgeFollowLoopsStencils) {
+  const int columns = 5;
+  const Mesh grid = Jittered(GridMesh(columns, 5), 0.2);
+  const SubdivisionStencil stencil = BuildLoopSubdivision(grid, 1);
+  const Mesh fine = ApplySubdivision(stencil, grid.vertices);
+  auto at = [&](int x, int y) -> Eigen::Vector3d {
+    return grid.vertices.col(GridId(x, y, columns));
+  };
+
+  // Valence 6: 5/8 of itself, 1/16 of each of (+-1, 0), (0, +-1), (1, 1), (-1, -1).
+  const Eigen::Vector3d ring_sum = at(3, 2) + at(1, 2) + at(2, 3) + at(2, 1) + at(3, 3) + at(1, 1);
+  const Eigen::Vector3d expected_vertex = 5.0 / 8.0 * at(2, 2) + ring_sum / 16.0;
+  EXPECT_LT((fine.vertices.col(GridId(2, 2, columns)) - expected_vertex).norm(), 1e-12);
+
+  // Edge (2, 2)-(3, 2) lies between triangles whose third corners are (3, 3) and (2, 1).
+  const Eigen::Vector3d expected_edge =
+      3.0 / 8.0 * (at(2, 2) + at(3, 2)) + 1.0 / 8.0 * (at(3, 3) + at(2, 1));
+  const int edge_point = EdgePoint(stencil, GridId(2, 2, columns), GridId(3, 2, columns));
+  EXPECT_LT((fine.vertices.col(edge_point) - expected_edge).norm(), 1e-12);
+}
+
+TEST(SubdivisionTest, BoundaryFollowsTheCreaseRules) {
+  const int columns = 5;
+  Mesh grid = Jittered(GridMesh(columns, 4), 0.2);
+  // Keep the bottom row on the line y = z = 0, unevenly spaced along x.
+  for (int x = 0; x < columns; ++x) grid.vertices.col(GridId(x, 0, columns)).tail<2>().setZero();
+  const SubdivisionStencil stencil = BuildLoopSubdivision(grid, 1);
+  const Mesh fine = ApplySubdivision(stencil, grid.vertices);
+  auto at = [&](int x, int y) -> Eigen::Vector3d {
+    return grid.vertices.col(GridId(x, y, columns));
+  };
+
+  const Eigen::Vector3d expected_vertex = 0.75 * at(2, 0) + 0.125 * (at(1, 0) + at(3, 0));
+  EXPECT_LT((fine.vertices.col(GridId(2, 0, columns)) - expected_vertex).norm(), 1e-12);
+  const int edge_point = EdgePoint(stencil, GridId(2, 0, columns), GridId(3, 0, columns));
+  EXPECT_LT((fine.vertices.col(edge_point) - 0.5 * (at(2, 0) + at(3, 0))).norm(), 1e-12);
+
+  // After two levels, the fine vertices computed from the bottom row alone stay on its line.
+  // The grid's corners are boundary vertices too, so they take 1/8 of their upper neighbour and
+  // leave the line; what depends on them does as well. That leaves, along the 17 fine boundary
+  // vertices of the bottom, the vertex points from x = 1 to 3 (5) and the edge points between
+  // x = 0.5 and 3.5 (6).
+  const SubdivisionStencil two = BuildLoopSubdivision(grid, 2);
+  const Mesh fine_two = ApplySubdivision(two, grid.vertices);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = two.matrix;
+  int from_bottom_row = 0;
+  for (int v = 0; v < rows.rows(); ++v) {
+    bool bottom_only = true;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, v); it; ++it) {
+      bottom_only = bottom_only && it.col() < columns;
+    }
+    if (!bottom_only) continue;
+    ++from_bottom_row;
+    EXPECT_LT(fine_two.vertices.col(v).tail<2>().norm(), 1e-12) << "fine vertex " << v;
+  }
+  EXPECT_EQ(from_bottom_row, 11);
+}
+
+TEST(SubdivisionTest, TubeHemsStayInTheirPlanes) {
+  const Mesh tube = TubeMesh(12, 4, 0.4, 0.6);
+  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(tube, 2), tube.vertices);
+  const MeshEdges edges = BuildMeshEdges(fine.faces);
+  int boundary_edges = 0;
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    if (!edges.IsBoundary(e)) continue;
+    ++boundary_edges;
+    for (int end = 0; end < 2; ++end) {
+      const double z = fine.vertices(2, edges.vertices(end, e));
+      EXPECT_TRUE(std::abs(z) < 1e-12 || std::abs(z - 0.6) < 1e-12) << "z = " << z;
+    }
+  }
+  EXPECT_EQ(boundary_edges, 2 * 12 * 4);  // Two hems, each edge split twice.
+}
+
+TEST(SubdivisionTest, PlanarMeshStaysPlanar) {
+  Mesh grid = Jittered(GridMesh(6, 5), 0.3);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.5, 1.0).normalized();
+  // Project the jittered points onto the plane normal . x = 0.7.
+  for (int v = 0; v < grid.num_vertices(); ++v) {
+    const Eigen::Vector3d p = grid.vertices.col(v);
+    grid.vertices.col(v) = p - (normal.dot(p) - 0.7) * normal;
+  }
+  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(grid, 2), grid.vertices);
+  const Eigen::ArrayXd heights = (normal.transpose() * fine.vertices).array() - 0.7;
+  EXPECT_LT(heights.abs().maxCoeff(), 1e-12);
+}
+
+// A geodesic sphere: the icosahedron's triangles split `levels` times, each new vertex the
+// normalised midpoint of its parents, found through the stencil's level_edges.
+Mesh GeodesicSphere(int levels) {
+  const Mesh ico = Icosahedron();
+  const SubdivisionStencil split = BuildLoopSubdivision(ico, levels);
+  Mesh sphere;
+  sphere.faces = split.faces;
+  sphere.vertices.resize(3, split.num_fine_vertices());
+  sphere.vertices.leftCols(12) = ico.vertices;
+  int next = 12;
+  for (const Eigen::Matrix2Xi& edges : split.level_edges) {
+    for (int e = 0; e < edges.cols(); ++e) {
+      sphere.vertices.col(next + e) =
+          (sphere.vertices.col(edges(0, e)) + sphere.vertices.col(edges(1, e))).normalized();
+    }
+    next += static_cast<int>(edges.cols());
+  }
+  return sphere;
+}
+
+// Largest distance of the twice Loop-subdivided surface from the unit sphere.
+double LoopDeviationFromSphere(const Mesh& sphere) {
+  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(sphere, 2), sphere.vertices);
+  return (fine.vertices.colwise().norm().array() - 1.0).abs().maxCoeff();
+}
+
+TEST(SubdivisionTest, SubdividedSphereStaysCloseToTheSphere) {
+  const Mesh coarse = GeodesicSphere(2);
+  ASSERT_EQ(coarse.num_vertices(), 162);
+  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(coarse, 2), coarse.vertices);
+  const Eigen::ArrayXd radii = fine.vertices.colwise().norm().transpose().array();
+  // Loop's surface lies slightly inside the control polygon of a convex surface.
+  EXPECT_LT(radii.maxCoeff(), 1.0);
+  EXPECT_GT(radii.minCoeff(), 0.97);
+  EXPECT_LT(radii.maxCoeff() - radii.minCoeff(), 0.01);
+  // The shrink is second order in the edge length: halving the edges divides it by about 4.
+  EXPECT_LT(LoopDeviationFromSphere(GeodesicSphere(3)), 0.3 * LoopDeviationFromSphere(coarse));
+}
+
+TEST(SubdivisionTest, LevelsComposeAsRepeatedSubdivision) {
+  const Mesh tube = Jittered(TubeMesh(5, 3), 0.1);
+  const SubdivisionStencil once = BuildLoopSubdivision(tube, 1);
+  const Mesh first = ApplySubdivision(once, tube.vertices);
+  const Mesh twice = ApplySubdivision(BuildLoopSubdivision(first, 1), first.vertices);
+  const Mesh direct = ApplySubdivision(BuildLoopSubdivision(tube, 2), tube.vertices);
+  EXPECT_EQ(direct.faces, twice.faces);
+  EXPECT_LT((direct.vertices - twice.vertices).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(SubdivisionTest, FineFacesKeepTheOrientation) {
+  const Mesh ico = Icosahedron();
+  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(ico, 2), ico.vertices);
+  for (int f = 0; f < fine.num_faces(); ++f) {
+    const Eigen::Vector3d a = fine.vertices.col(fine.faces(0, f));
+    const Eigen::Vector3d b = fine.vertices.col(fine.faces(1, f));
+    const Eigen::Vector3d c = fine.vertices.col(fine.faces(2, f));
+    EXPECT_GT((b - a).cross(c - a).dot(a + b + c), 0.0) << "triangle " << f << " faces inwards";
+  }
+}
+
+TEST(SubdivisionTest, MaskKeepsEdgePointsWhoseParentsAreBothIn) {
+  const Mesh tube = TubeMesh(6, 3);
+  const SubdivisionStencil stencil = BuildLoopSubdivision(tube, 2);
+  std::vector<bool> mask(tube.num_vertices(), false);
+  for (int v = 6; v < 18; ++v) mask[v] = true;  // The upper two rings.
+  const std::vector<bool> fine_mask = SubdivideVertexMask(stencil, mask);
+  ASSERT_EQ(static_cast<int>(fine_mask.size()), stencil.num_fine_vertices());
+  const Mesh fine = ApplySubdivision(stencil, tube.vertices);
+  // Exactly the fine vertices at or above the middle ring's height, up to rounding.
+  for (int v = 0; v < stencil.num_fine_vertices(); ++v) {
+    EXPECT_EQ(fine_mask[v], fine.vertices(2, v) > 0.5 - 1e-9) << "fine vertex " << v;
+  }
+  EXPECT_THROW(SubdivideVertexMask(stencil, std::vector<bool>(3, true)), Error);
+}
+
+TEST(SubdivisionTest, RefusesNonManifoldEdgesAndWrongFrames) {
+  Mesh fan;  // Three triangles on the edge (0, 1).
+  fan.vertices = Eigen::Matrix3Xd::Random(3, 5);
+  fan.faces.resize(3, 3);
+  fan.faces << 0, 0, 0, 1, 1, 1, 2, 3, 4;
+  try {
+    BuildLoopSubdivision(fan, 1, "fan.ply");
+    FAIL() << "no error";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("fan.ply"), std::string::npos) << message;
+    EXPECT_NE(message.find("edge (0, 1) is shared by 3 triangles"), std::string::npos) << message;
+    EXPECT_NE(message.find("non-manifold"), std::string::npos) << message;
+  }
+  EXPECT_THROW(BuildLoopSubdivision(Icosahedron(), -1), Error);
+
+  const SubdivisionStencil stencil = BuildLoopSubdivision(Icosahedron(), 1);
+  try {
+    ApplySubdivision(stencil, Eigen::Matrix3Xd::Zero(3, 11), "frame_0007.ply");
+    FAIL() << "no error";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("frame_0007.ply"), std::string::npos) << message;
+    EXPECT_NE(message.find("11 vertices but the subdivision was built for 12"), std::string::npos)
+        << message;
+  }
+}
+
+}  // namespace
+}  // namespace finecap

@@ -1,0 +1,81 @@
+// Small procedural meshes shared by the topology tests and benchmarks.
+#ifndef FINECAP_TESTS_TEST_MESHES_H_
+#define FINECAP_TESTS_TEST_MESHES_H_
+
+#include <cmath>
+
+#include "finecap/mesh.h"
+
+namespace finecap {
+namespace testing_meshes {
+
+// Vertex id of grid point (x, y) in a grid `columns` wide.
+inline int GridId(int x, int y, int columns) { return y * columns + x; }
+
+// A planar grid on z = 0 with unit spacing, vertex (x, y) at GridId(x, y). Each cell is split
+// along its (x, y)-(x + 1, y + 1) diagonal, so every interior vertex has valence 6 with neighbours
+// at offsets (+-1, 0), (0, +-1), (1, 1), (-1, -1). Triangles are counter-clockwise seen from +z.
+inline Mesh GridMesh(int columns, int rows) {
+  Mesh mesh;
+  mesh.vertices.resize(3, columns * rows);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < columns; ++x) mesh.vertices.col(GridId(x, y, columns)) << x, y, 0.0;
+  }
+  mesh.faces.resize(3, 2 * (columns - 1) * (rows - 1));
+  int f = 0;
+  for (int y = 0; y + 1 < rows; ++y) {
+    for (int x = 0; x + 1 < columns; ++x) {
+      const int v00 = GridId(x, y, columns), v10 = GridId(x + 1, y, columns);
+      const int v01 = GridId(x, y + 1, columns), v11 = GridId(x + 1, y + 1, columns);
+      mesh.faces.col(f++) << v00, v10, v11;
+      mesh.faces.col(f++) << v00, v11, v01;
+    }
+  }
+  return mesh;
+}
+
+// The regular icosahedron with its 12 vertices on the unit sphere, triangles facing outwards.
+inline Mesh Icosahedron() {
+  const double p = (1.0 + std::sqrt(5.0)) / 2.0;
+  Mesh mesh;
+  mesh.vertices.resize(3, 12);
+  mesh.vertices << -1, 1, -1, 1, 0, 0, 0, 0, p, p, -p, -p,  //
+      p, p, -p, -p, -1, 1, -1, 1, 0, 0, 0, 0,               //
+      0, 0, 0, 0, p, p, -p, -p, -1, 1, -1, 1;
+  mesh.vertices.colwise().normalize();
+  mesh.faces.resize(3, 20);
+  mesh.faces << 0, 0, 0, 0, 0, 1, 5, 11, 10, 7, 3, 3, 3, 3, 3, 4, 2, 6, 8, 9,  //
+      11, 5, 1, 7, 10, 5, 11, 10, 7, 1, 9, 4, 2, 6, 8, 9, 4, 2, 6, 8,          //
+      5, 1, 7, 10, 11, 9, 4, 2, 6, 8, 4, 2, 6, 8, 9, 5, 11, 10, 7, 1;
+  return mesh;
+}
+
+// An open cylinder (a skirt) around the z axis: `rings` circles of `segments` vertices from
+// z = 0 to z = height, vertex (segment, ring) at ring * segments + segment, triangles facing out.
+inline Mesh TubeMesh(int segments, int rings, double radius = 1.0, double height = 1.0) {
+  Mesh mesh;
+  mesh.vertices.resize(3, segments * rings);
+  for (int r = 0; r < rings; ++r) {
+    for (int s = 0; s < segments; ++s) {
+      const double angle = 2.0 * M_PI * s / segments;
+      mesh.vertices.col(r * segments + s) << radius * std::cos(angle), radius * std::sin(angle),
+          height * r / (rings - 1);
+    }
+  }
+  mesh.faces.resize(3, 2 * segments * (rings - 1));
+  int f = 0;
+  for (int r = 0; r + 1 < rings; ++r) {
+    for (int s = 0; s < segments; ++s) {
+      const int a = r * segments + s, b = r * segments + (s + 1) % segments;
+      const int c = a + segments, d = b + segments;
+      mesh.faces.col(f++) << a, b, d;
+      mesh.faces.col(f++) << a, d, c;
+    }
+  }
+  return mesh;
+}
+
+}  // namespace testing_meshes
+}  // namespace finecap
+
+#endif  // FINECAP_TESTS_TEST_MESHES_H_
