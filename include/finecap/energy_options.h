@@ -1,0 +1,43 @@
+// Options of the refinement energy E = E_sim - w_reg * E_reg (the paper's section 5).
+#ifndef FINECAP_ENERGY_OPTIONS_H_
+#define FINECAP_ENERGY_OPTIONS_H_
+
+#include <string>
+
+namespace finecap {
+
+struct EnergyOptions {
+  // Which similarity E_sim measures:
+  //  "paper":         the paper's E_sim as printed, with the min() clamp per image Gaussian;
+  //  "surface_color": each surface Gaussian's colour against the image colour around its
+  //                   projection, the overlap-weighted mean of the image Gaussians' colours (a
+  //                   closed-form least-squares residual per surface Gaussian and camera; see
+  //                   the README for why it peaks at the true surface where the paper's does not).
+  std::string similarity = "paper";
+  // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
+  // (the true integral, half the exponent). See gaussian_overlap.h.
+  std::string overlap = "printed";
+  // Cut-off D of the Wendland colour weight T(|eta_i - eta_s|) of the paper's E_sim, in colour
+  // distance units (color.h). Paper: 0.05.
+  double color_cutoff = 0.05;
+  // A pair of Gaussians is evaluated when their means are less than this many combined standard
+  // deviations sqrt(sigma_s^2 + sigma_i^2) apart for some allowed k. Default 3.
+  double reach_sigmas = 3.0;
+  // Bound on the displacement |k| along the normal, metres. Default 0.02.
+  double k_max = 0.02;
+  // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg).
+  double w_reg = 1.0;
+  // Neighbourhood size Delta of the regulariser, edges; also the Wendland cut-off of its weights
+  // T(delta_sj). Paper: 2.
+  int reg_rings = 2;
+  // Unit in which k enters E_reg: "mm" (the paper's lengths) or "m".
+  std::string reg_unit = "mm";
+
+  // Metres to the unit of E_reg.
+  double RegUnitScale() const { return reg_unit == "mm" ? 1000.0 : 1.0; }
+  void Check() const;
+};
+
+}  // namespace finecap
+
+#endif  // FINECAP_ENERGY_OPTIONS_H_

@@ -1,0 +1,53 @@
+// The similarity term E_sim of the energy, in the two forms the solvers need:
+//  * a scalar to maximise, with its gradient (the paper's gradient ascent, L-BFGS);
+//  * residual blocks of a least-squares problem, each depending on a few k_s, with Jacobians
+//    (Ceres), such that a smaller sum of squares means a higher similarity.
+// Implementations: PaperSimilarity (paper_similarity.h), SurfaceColorSimilarity
+// (surface_color_similarity.h).
+#ifndef FINECAP_SIMILARITY_H_
+#define FINECAP_SIMILARITY_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "finecap/camera.h"
+#include "finecap/gaussian_pairs.h"
+#include "finecap/image_gaussians.h"
+
+namespace finecap {
+
+// One camera of a frame as the energy sees it.
+struct EnergyView {
+  Camera camera;                          // Pinhole: the images are undistorted.
+  const ImageGaussians* image = nullptr;  // Not owned; outlives the energy.
+  CameraPairs pairs;
+};
+
+class SimilarityTerm {
+ public:
+  // One block of residuals and the surface Gaussians (parameters k_s) it depends on.
+  struct ResidualBlock {
+    std::vector<int> parameters;
+    int num_residuals = 0;
+  };
+
+  virtual ~SimilarityTerm() = default;
+
+  // The similarity at `k` (one entry per surface Gaussian, metres); higher is better. When
+  // `gradient` is not null it receives dE_sim/dk.
+  virtual double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const = 0;
+
+  virtual const std::vector<ResidualBlock>& residual_blocks() const = 0;
+  // Computes every residual (and, if asked, Jacobian) at `k` once; BlockResiduals then reads
+  // them, from any number of threads, until the next call.
+  virtual void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) = 0;
+  // residuals[r] for r < num_residuals; when `jacobian` is not null, jacobian[r * P + p] =
+  // d residual r / d k of parameters[p], P = parameters.size().
+  virtual void BlockResiduals(int block, double* residuals, double* jacobian) const = 0;
+};
+
+}  // namespace finecap
+
+#endif  // FINECAP_SIMILARITY_H_

@@ -1,0 +1,66 @@
+// The surface model of the energy: one isotropic 3D Gaussian per refined vertex, sliding along the
+// vertex normal, mu_s(k_s) = base_s + k_s * normal_s, with a colour eta_s taken once per sequence
+// from a reference frame (the paper's section 4.1).
+#ifndef FINECAP_SURFACE_GAUSSIANS_H_
+#define FINECAP_SURFACE_GAUSSIANS_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "finecap/camera.h"
+#include "finecap/color.h"
+
+namespace finecap {
+
+// The surface Gaussians of one frame.
+struct SurfaceGaussians {
+  std::vector<int> vertex_ids;          // The mesh vertex each Gaussian sits on.
+  Eigen::Matrix3Xd base;                // Positions at k = 0 (the input vertices), metres.
+  Eigen::Matrix3Xd normals;             // Unit normals of the input mesh.
+  std::vector<Eigen::Vector3f> colors;  // eta_s, embedded in `color_space` (see color.h).
+  ColorSpace color_space = ColorSpace::kHsv;
+  double sigma_hat = 0.007;  // Standard deviation, metres (paper: 7 mm).
+
+  int size() const { return static_cast<int>(vertex_ids.size()); }
+};
+
+// Colours of the vertices of a mesh, taken from one frame's images, with a flag per vertex that
+// says whether any camera saw it. Saved once per sequence so that any frame can run on its own.
+struct ReferenceColors {
+  ColorSpace color_space = ColorSpace::kHsv;
+  double sigma_hat = 0.007;             // The footprint they were averaged over, metres.
+  std::vector<Eigen::Vector3f> colors;  // One per mesh vertex.
+  std::vector<unsigned char> valid;     // 1 where a camera saw the vertex.
+};
+
+// The paper's colouring: for each vertex, the camera that sees it best (visible, and whose
+// viewing direction aligns best with the normal), where the mean of the pixel colours under the
+// projected Gaussian (weights of the Gaussian, out to 2 sigma) becomes its colour.
+// `visible[c][v]` says whether camera c sees vertex v; `images[c]` are the undistorted 8-bit
+// BGR images of that frame.
+ReferenceColors ComputeReferenceColors(const Eigen::Matrix3Xd& vertices,
+                                       const Eigen::Matrix3Xd& normals,
+                                       const std::vector<Camera>& cameras,
+                                       const std::vector<cv::Mat>& images,
+                                       const std::vector<std::vector<unsigned char>>& visible,
+                                       ColorSpace color_space, double sigma_hat);
+
+// A text file, one vertex a line; the header states the colour space and sigma_hat. Written
+// atomically. Reading throws Error naming the file when it is malformed or was made for another
+// number of vertices (`expected_vertices`, or any when negative).
+void WriteReferenceColors(const std::string& path, const ReferenceColors& colors);
+ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertices = -1);
+
+// The surface Gaussians of a frame: one per vertex in `vertex_ids` whose reference colour is
+// valid and whose normal is defined.
+SurfaceGaussians MakeSurfaceGaussians(const Eigen::Matrix3Xd& vertices,
+                                      const Eigen::Matrix3Xd& normals,
+                                      const std::vector<int>& vertex_ids,
+                                      const ReferenceColors& colors);
+
+}  // namespace finecap
+
+#endif  // FINECAP_SURFACE_GAUSSIANS_H_

@@ -1,0 +1,39 @@
+// Which surface points a camera sees: in front of it, inside its image, facing it, and not
+// hidden behind another part of the surface according to a depth map rendered from the input
+// mesh (the paper evaluates its energy only for visible surface Gaussians).
+#ifndef FINECAP_VISIBILITY_H_
+#define FINECAP_VISIBILITY_H_
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "finecap/camera.h"
+
+namespace finecap {
+
+struct VisibilityOptions {
+  // A point is occluded when it lies more than this behind the rendered surface, metres.
+  // Default 0.01: the input mesh is coarse, folds move the true surface by up to ~2 cm.
+  double depth_tolerance = 0.01;
+  // Largest angle between the normal and the direction to the camera, degrees; beyond it the
+  // point is back-facing or so grazing that its projection is unreliable. Default 75.
+  double max_view_angle_deg = 75.0;
+  // Points projecting closer than this to the image border are not used, pixels. Default 2.
+  double border_margin = 2.0;
+
+  void Check() const;
+};
+
+// visible[p] = 1 when `camera` sees point p with unit normal `normals.col(p)`. `depth_map` is a
+// CV_32F image of the camera's size holding the depth (camera z) of the nearest surface at each
+// pixel, +infinity where there is none.
+std::vector<unsigned char> ComputeVisibility(const Camera& camera, const cv::Mat& depth_map,
+                                             const Eigen::Matrix3Xd& points,
+                                             const Eigen::Matrix3Xd& normals,
+                                             const VisibilityOptions& options);
+
+}  // namespace finecap
+
+#endif  // FINECAP_VISIBILITY_H_

@@ -1,0 +1,86 @@
+#include "finecap/frame_energy.h"
+
+#include "finecap/error.h"
+#include "finecap/paper_similarity.h"
+#include "finecap/surface_color_similarity.h"
+
+namespace finecap {
+
+void EnergyOptions::Check() const {
+  Require(similarity == "paper" || similarity == "surface_color", "energy.similarity",
+          "'" + similarity + "' is not one of: paper, surface_color");
+  ParseOverlapForm(overlap);
+  Require(color_cutoff > 0.0, "energy.color_cutoff", "must be positive");
+  Require(reach_sigmas > 0.0, "energy.reach_sigmas", "must be positive");
+  Require(k_max > 0.0, "energy.k_max", "must be positive");
+  Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
+  Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
+  Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
+}
+
+namespace {
+
+const EnergyOptions& Checked(const EnergyOptions& options) {
+  options.Check();
+  return options;
+}
+
+std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
+                                   const std::vector<CameraInput>& cameras,
+                                   const EnergyOptions& options) {
+  PairOptions pair_options;
+  pair_options.k_max = options.k_max;
+  pair_options.reach_sigmas = options.reach_sigmas;
+  // The paper's similarity weighs pairs by colour agreement; the colour residual compares
+  // colours itself and needs every pair in reach.
+  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  std::vector<EnergyView> views(cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    Require(cameras[c].visible.size() == static_cast<size_t>(surface.size()),
+            cameras[c].camera.name, "visibility must have one flag per surface Gaussian");
+    views[c].camera = cameras[c].camera;
+    views[c].image = cameras[c].image;
+    views[c].pairs = BuildCameraPairs(cameras[c].camera, *cameras[c].image, surface,
+                                      cameras[c].visible, pair_options);
+  }
+  return views;
+}
+
+std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
+                                               const std::vector<EnergyView>& views,
+                                               const EnergyOptions& options) {
+  const OverlapForm form = ParseOverlapForm(options.overlap);
+  if (options.similarity == "paper") return std::make_unique<PaperSimilarity>(surface, views, form);
+  return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
+}
+
+}  // namespace
+
+FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput>& cameras,
+                         const VertexNeighbourhoods& neighbourhoods, const EnergyOptions& options)
+    : surface_(std::move(surface)),
+      options_(Checked(options)),
+      views_(BuildViews(surface_, cameras, options_)),
+      similarity_(MakeSimilarity(surface_, views_, options_)),
+      regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
+                   options_.RegUnitScale()) {}
+
+long FrameEnergy::num_pairs() const {
+  long pairs = 0;
+  for (const EnergyView& view : views_) pairs += view.pairs.num_pairs();
+  return pairs;
+}
+
+double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient,
+                             double* similarity, double* regularization) const {
+  Eigen::VectorXd similarity_gradient, regularization_gradient;
+  const double e_sim = similarity_->Evaluate(k, gradient ? &similarity_gradient : nullptr);
+  const double e_reg = regularizer_.Evaluate(k, gradient ? &regularization_gradient : nullptr);
+  if (gradient != nullptr)
+    *gradient = similarity_gradient - options_.w_reg * regularization_gradient;
+  if (similarity != nullptr) *similarity = e_sim;
+  if (regularization != nullptr) *regularization = e_reg;
+  return e_sim - options_.w_reg * e_reg;
+}
+
+}  // namespace finecap

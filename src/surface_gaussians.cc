@@ -1,0 +1,161 @@
+#include "finecap/surface_gaussians.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "finecap/atomic_file.h"
+#include "finecap/error.h"
+
+namespace finecap {
+namespace {
+
+// The camera whose viewing direction (from the vertex towards the camera) aligns best with the
+// normal, among those that see the vertex; -1 when none does.
+int BestAlignedCamera(const Eigen::Vector3d& vertex, const Eigen::Vector3d& normal,
+                      const std::vector<Camera>& cameras,
+                      const std::vector<std::vector<unsigned char>>& visible, int v) {
+  int best = -1;
+  double best_alignment = -2.0;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    if (!visible[c][v]) continue;
+    const double alignment = normal.dot((cameras[c].Center() - vertex).normalized());
+    if (alignment > best_alignment) {
+      best_alignment = alignment;
+      best = static_cast<int>(c);
+    }
+  }
+  return best;
+}
+
+// Mean of the pixels of `image` (CV_32FC3) under a Gaussian of standard deviation `sigma` pixels
+// centred at `mean`, weighted by the Gaussian, out to two standard deviations.
+bool GaussianWeightedMean(const cv::Mat& image, const Eigen::Vector2d& mean, double sigma,
+                          Eigen::Vector3f* color) {
+  const double radius = std::max(2.0 * sigma, 1.0);
+  const int x0 = std::max(0, static_cast<int>(std::floor(mean.x() - radius)));
+  const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(mean.x() + radius)));
+  const int y0 = std::max(0, static_cast<int>(std::floor(mean.y() - radius)));
+  const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(mean.y() + radius)));
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double weight_sum = 0.0;
+  for (int y = y0; y <= y1; ++y) {
+    const cv::Vec3f* row = image.ptr<cv::Vec3f>(y);
+    for (int x = x0; x <= x1; ++x) {
+      const double d2 = (Eigen::Vector2d(x, y) - mean).squaredNorm();
+      if (d2 > radius * radius) continue;
+      const double weight = std::exp(-0.5 * d2 / (sigma * sigma));
+      sum += weight * Eigen::Vector3d(row[x][0], row[x][1], row[x][2]);
+      weight_sum += weight;
+    }
+  }
+  if (weight_sum <= 0.0) return false;
+  *color = (sum / weight_sum).cast<float>();
+  return true;
+}
+
+}  // namespace
+
+ReferenceColors ComputeReferenceColors(const Eigen::Matrix3Xd& vertices,
+                                       const Eigen::Matrix3Xd& normals,
+                                       const std::vector<Camera>& cameras,
+                                       const std::vector<cv::Mat>& images,
+                                       const std::vector<std::vector<unsigned char>>& visible,
+                                       ColorSpace color_space, double sigma_hat) {
+  std::vector<cv::Mat> converted(images.size());
+  for (size_t c = 0; c < images.size(); ++c) {
+    converted[c] = ConvertImage(images[c], color_space, cameras[c].name);
+  }
+  ReferenceColors result;
+  result.color_space = color_space;
+  result.sigma_hat = sigma_hat;
+  const int n = static_cast<int>(vertices.cols());
+  result.colors.assign(n, Eigen::Vector3f::Zero());
+  result.valid.assign(n, 0);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (int v = 0; v < n; ++v) {
+    const int c = BestAlignedCamera(vertices.col(v), normals.col(v), cameras, visible, v);
+    if (c < 0) continue;
+    const Camera& camera = cameras[c];
+    const double z = camera.Depth(vertices.col(v));
+    const double sigma = sigma_hat * camera.focal() / z;
+    result.valid[v] = GaussianWeightedMean(converted[c], camera.Project(vertices.col(v)), sigma,
+                                           &result.colors[v]);
+  }
+  return result;
+}
+
+void WriteReferenceColors(const std::string& path, const ReferenceColors& colors) {
+  std::ostringstream text;
+  text
+      << "# finecap reference colours: one line per mesh vertex, 'valid c0 c1 c2' with the colour\n"
+      << "# embedded in the colour space below (see the README); valid = 0 where no camera saw\n"
+      << "# the vertex in the reference frame.\n"
+      << "color_space " << ColorSpaceName(colors.color_space) << "\n"
+      << std::setprecision(9) << "sigma_hat " << colors.sigma_hat << "\n"
+      << "vertices " << colors.colors.size() << "\n";
+  for (size_t v = 0; v < colors.colors.size(); ++v) {
+    const Eigen::Vector3f& c = colors.colors[v];
+    text << int(colors.valid[v]) << " " << c(0) << " " << c(1) << " " << c(2) << "\n";
+  }
+  WriteTextFileAtomically(path, text.str());
+}
+
+ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertices) {
+  std::ifstream stream(path);
+  Require(stream.is_open(), path, "cannot open the reference colours");
+  std::string line, word, space_name;
+  ReferenceColors colors;
+  int count = -1;
+  const auto read_header = [&](const std::string& key, auto* value) {
+    while (std::getline(stream, line) && (line.empty() || line[0] == '#')) {
+    }
+    std::istringstream fields(line);
+    Require(static_cast<bool>(fields >> word >> *value) && word == key, path,
+            "expected '" + key + " <value>', got '" + line + "'");
+  };
+  read_header("color_space", &space_name);
+  colors.color_space = ParseColorSpace(space_name, path);
+  read_header("sigma_hat", &colors.sigma_hat);
+  read_header("vertices", &count);
+  Require(count >= 0, path, "negative vertex count");
+  Require(expected_vertices < 0 || count == expected_vertices, path,
+          "made for " + std::to_string(count) + " vertices, but the mesh has " +
+              std::to_string(expected_vertices));
+  colors.colors.resize(count);
+  colors.valid.resize(count);
+  for (int v = 0; v < count; ++v) {
+    int valid = 0;
+    Eigen::Vector3f& c = colors.colors[v];
+    Require(static_cast<bool>(stream >> valid >> c(0) >> c(1) >> c(2)) && c.allFinite(), path,
+            "malformed or missing line for vertex " + std::to_string(v));
+    colors.valid[v] = valid != 0;
+  }
+  return colors;
+}
+
+SurfaceGaussians MakeSurfaceGaussians(const Eigen::Matrix3Xd& vertices,
+                                      const Eigen::Matrix3Xd& normals,
+                                      const std::vector<int>& vertex_ids,
+                                      const ReferenceColors& colors) {
+  SurfaceGaussians surface;
+  surface.color_space = colors.color_space;
+  surface.sigma_hat = colors.sigma_hat;
+  for (int v : vertex_ids) {
+    if (colors.valid[v] && normals.col(v).squaredNorm() > 0.5) surface.vertex_ids.push_back(v);
+  }
+  const int n = surface.size();
+  surface.base.resize(3, n);
+  surface.normals.resize(3, n);
+  surface.colors.resize(n);
+  for (int s = 0; s < n; ++s) {
+    const int v = surface.vertex_ids[s];
+    surface.base.col(s) = vertices.col(v);
+    surface.normals.col(s) = normals.col(v);
+    surface.colors[s] = colors.colors[v];
+  }
+  return surface;
+}
+
+}  // namespace finecap

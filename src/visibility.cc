@@ -1,0 +1,63 @@
+#include "finecap/visibility.h"
+
+#include <cmath>
+
+#include "finecap/error.h"
+
+namespace finecap {
+
+void VisibilityOptions::Check() const {
+  Require(depth_tolerance >= 0.0, "visibility.depth_tolerance", "must be non-negative");
+  Require(max_view_angle_deg > 0.0 && max_view_angle_deg <= 90.0, "visibility.max_view_angle_deg",
+          "must lie in (0, 90]");
+  Require(border_margin >= 0.0, "visibility.border_margin", "must be non-negative");
+}
+
+namespace {
+
+// The nearest rendered depth among the four pixels around a sub-pixel position: a point that
+// lies on the surface is then never declared occluded by its own triangle's rasterisation.
+float NearestRenderedDepth(const cv::Mat& depth_map, const Eigen::Vector2d& pixel) {
+  const int x0 = static_cast<int>(std::floor(pixel.x()));
+  const int y0 = static_cast<int>(std::floor(pixel.y()));
+  float nearest = std::numeric_limits<float>::infinity();
+  for (int y = std::max(0, y0); y <= std::min(depth_map.rows - 1, y0 + 1); ++y) {
+    for (int x = std::max(0, x0); x <= std::min(depth_map.cols - 1, x0 + 1); ++x) {
+      nearest = std::min(nearest, depth_map.at<float>(y, x));
+    }
+  }
+  return nearest;
+}
+
+}  // namespace
+
+std::vector<unsigned char> ComputeVisibility(const Camera& camera, const cv::Mat& depth_map,
+                                             const Eigen::Matrix3Xd& points,
+                                             const Eigen::Matrix3Xd& normals,
+                                             const VisibilityOptions& options) {
+  Require(depth_map.type() == CV_32F && depth_map.cols == camera.width &&
+              depth_map.rows == camera.height,
+          camera.name, "the depth map must be CV_32F of the camera's size");
+  const double min_cosine = std::cos(options.max_view_angle_deg * M_PI / 180.0);
+  const Eigen::Vector3d center = camera.Center();
+  const int n = static_cast<int>(points.cols());
+  std::vector<unsigned char> visible(n, 0);
+#pragma omp parallel for schedule(static)
+  for (int p = 0; p < n; ++p) {
+    const Eigen::Vector3d point = points.col(p);
+    const double depth = camera.Depth(point);
+    if (!(depth > 0.0)) continue;
+    const Eigen::Vector3d to_camera = (center - point).normalized();
+    if (normals.col(p).dot(to_camera) < min_cosine) continue;
+    const Eigen::Vector2d pixel = camera.Project(point);
+    const double margin = options.border_margin;
+    if (pixel.x() < margin || pixel.y() < margin || pixel.x() > camera.width - 1 - margin ||
+        pixel.y() > camera.height - 1 - margin) {
+      continue;
+    }
+    visible[p] = depth <= NearestRenderedDepth(depth_map, pixel) + options.depth_tolerance;
+  }
+  return visible;
+}
+
+}  // namespace finecap

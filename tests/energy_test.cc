@@ -1,0 +1,174 @@
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "energy_fixture.h"
+#include "finecap/frame_energy.h"
+#include "finecap/paper_similarity.h"
+#include "finecap/surface_color_similarity.h"
+
+namespace finecap {
+namespace {
+
+Eigen::VectorXd RandomK(int n, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::VectorXd k(n);
+  for (int s = 0; s < n; ++s) k[s] = amplitude * unit(rng);
+  return k;
+}
+
+// Central differences of a scalar function of k, one coordinate at a time.
+template <typename Function>
+Eigen::VectorXd NumericGradient(const Function& f, const Eigen::VectorXd& k, double h) {
+  Eigen::VectorXd gradient(k.size());
+  for (int s = 0; s < k.size(); ++s) {
+    Eigen::VectorXd plus = k, minus = k;
+    plus[s] += h;
+    minus[s] -= h;
+    gradient[s] = (f(plus) - f(minus)) / (2.0 * h);
+  }
+  return gradient;
+}
+
+EnergyOptions Options(const std::string& similarity, const std::string& overlap) {
+  EnergyOptions options;
+  options.similarity = similarity;
+  options.overlap = overlap;
+  options.k_max = 0.01;
+  return options;
+}
+
+class EnergyDerivativeTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {
+};
+
+// dE/dk of the full energy (similarity and regulariser) against central differences, for
+// cameras from straight on to grazing (80 degrees).
+TEST_P(EnergyDerivativeTest, GradientMatchesCentralDifferences) {
+  const auto [similarity, overlap] = GetParam();
+  const EnergyScene scene = MakeEnergyScene({0.0, 0.5, 1.0, 1.4}, 3, 5);
+  const FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                           Options(similarity, overlap));
+  ASSERT_GT(energy.num_pairs(), 100);
+  for (unsigned trial = 0; trial < 3; ++trial) {
+    const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.004, trial);
+    Eigen::VectorXd analytic;
+    energy.Evaluate(k, &analytic);
+    const Eigen::VectorXd numeric = NumericGradient(
+        [&](const Eigen::VectorXd& x) { return energy.Evaluate(x, nullptr); }, k, 1e-7);
+    // The paper's min() has kinks; coordinates whose difference quotient straddles one are rare
+    // and are the only ones allowed to disagree.
+    int disagreeing = 0;
+    for (int s = 0; s < k.size(); ++s) {
+      const double error = std::abs(analytic[s] - numeric[s]);
+      disagreeing += error > 1e-6 * std::max(numeric.cwiseAbs().maxCoeff(), 1e-12);
+    }
+    EXPECT_LE(disagreeing, similarity == "paper" ? 1 : 0) << "trial " << trial;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllForms, EnergyDerivativeTest,
+                         ::testing::Combine(::testing::Values("paper", "surface_color"),
+                                            ::testing::Values("printed", "exact")),
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + "_" + std::get<1>(info.param);
+                         });
+
+// Every least-squares residual's Jacobian against central differences of the residuals.
+TEST_P(EnergyDerivativeTest, ResidualJacobiansMatchCentralDifferences) {
+  const auto [similarity, overlap] = GetParam();
+  EnergyScene scene = MakeEnergyScene({0.0, 0.7, 1.3}, 3, 9);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options(similarity, overlap));
+  SimilarityTerm& term = energy.similarity();
+  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.003, 17);
+  const double h = 1e-7;
+  term.PrepareResiduals(k, true);
+  int checked = 0, disagreeing = 0;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    const auto& block = term.residual_blocks()[b];
+    const int R = block.num_residuals, P = static_cast<int>(block.parameters.size());
+    std::vector<double> residuals(R), jacobian(R * P);
+    term.BlockResiduals(b, residuals.data(), jacobian.data());
+    for (int p = 0; p < P; ++p) {
+      std::vector<double> plus(R), minus(R);
+      Eigen::VectorXd shifted = k;
+      shifted[block.parameters[p]] += h;
+      term.PrepareResiduals(shifted, false);
+      term.BlockResiduals(b, plus.data(), nullptr);
+      shifted[block.parameters[p]] -= 2 * h;
+      term.PrepareResiduals(shifted, false);
+      term.BlockResiduals(b, minus.data(), nullptr);
+      for (int r = 0; r < R; ++r) {
+        const double numeric = (plus[r] - minus[r]) / (2 * h);
+        const double error = std::abs(numeric - jacobian[r * P + p]);
+        disagreeing += error > 1e-6 * std::max(std::abs(numeric), 1.0);
+        ++checked;
+      }
+    }
+    term.PrepareResiduals(k, true);
+    if (b > 150) break;  // Enough blocks; each costs a full preparation per parameter.
+  }
+  EXPECT_GT(checked, 140);
+  EXPECT_LE(disagreeing, similarity == "paper" ? 2 : 0);
+}
+
+// The least-squares residuals and the scalar similarity describe the same colour residual.
+TEST(SurfaceColorSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 3);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("surface_color", "printed"));
+  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.005, 4);
+  SimilarityTerm& term = energy.similarity();
+  term.PrepareResiduals(k, false);
+  double sum = 0.0;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    std::vector<double> residuals(term.residual_blocks()[b].num_residuals);
+    term.BlockResiduals(b, residuals.data(), nullptr);
+    for (double r : residuals) sum += r * r;
+  }
+  EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
+}
+
+// Near the min() clamp: scale one camera's image Gaussians so that the overlap sums sit just
+// below E_ii, where the gradient is still defined and must match.
+TEST(PaperSimilarityTest, GradientNearTheClampMatches) {
+  EnergyScene scene = MakeEnergyScene({0.0}, 4, 21);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, Options("paper", "exact"));
+  const Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
+  Eigen::VectorXd analytic;
+  const double value = energy.similarity().Evaluate(k, &analytic);
+  const Eigen::VectorXd numeric = NumericGradient(
+      [&](const Eigen::VectorXd& x) { return energy.similarity().Evaluate(x, nullptr); }, k, 1e-8);
+  EXPECT_GT(value, 0.0);
+  EXPECT_LT((analytic - numeric).norm(), 1e-5 * numeric.norm() + 1e-9);
+}
+
+TEST(RegularizerTest, MatchesThePapersDoubleSumAndItsGradient) {
+  const Mesh mesh = GridMesh(5, 5, 0.01);
+  const VertexNeighbourhoods neighbourhoods = BuildVertexNeighbourhoods(mesh, 3);
+  // Surface Gaussians on every vertex but 12 (the centre), which stays at k = 0.
+  std::vector<int> ids;
+  for (int v = 0; v < 25; ++v) {
+    if (v != 12) ids.push_back(v);
+  }
+  const Regularizer regularizer(neighbourhoods, ids, 3, 1000.0);
+  const Eigen::VectorXd k = RandomK(24, 0.003, 8);
+  Eigen::VectorXd full = Eigen::VectorXd::Zero(25);
+  for (int s = 0; s < 24; ++s) full[ids[s]] = k[s];
+  double expected = 0.0;
+  for (int v = 0; v < 25; ++v) {
+    for (int e = neighbourhoods.offsets[v]; e < neighbourhoods.offsets[v + 1]; ++e) {
+      const double difference = 1000.0 * (full[v] - full[neighbourhoods.neighbours[e]]);
+      expected += Wendland(neighbourhoods.edge_distances[e], 3) * difference * difference;
+    }
+  }
+  Eigen::VectorXd analytic;
+  EXPECT_NEAR(regularizer.Evaluate(k, &analytic), expected, 1e-9 * expected);
+  const Eigen::VectorXd numeric = NumericGradient(
+      [&](const Eigen::VectorXd& x) { return regularizer.Evaluate(x, nullptr); }, k, 1e-7);
+  EXPECT_LT((analytic - numeric).norm(), 1e-6 * numeric.norm());
+}
+
+}  // namespace
+}  // namespace finecap
