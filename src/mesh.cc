@@ -9,12 +9,17 @@ namespace finecap {
 void Mesh::Validate(const std::string& where) const {
   Require(num_faces() > 0, where, "the mesh has no triangles");
   Require(vertices.allFinite(), where, "the mesh has a NaN or infinite vertex coordinate");
+  // Checked with `if` rather than Require: building the message for each of a large mesh's
+  // triangles would cost more than the checks themselves.
   for (int f = 0; f < num_faces(); ++f) {
     const Eigen::Vector3i face = faces.col(f);
-    Require(face.minCoeff() >= 0 && face.maxCoeff() < num_vertices(), where,
-            "triangle " + std::to_string(f) + " refers to a vertex that does not exist");
-    Require(face(0) != face(1) && face(1) != face(2) && face(0) != face(2), where,
-            "triangle " + std::to_string(f) + " repeats a vertex");
+    if (face.minCoeff() < 0 || face.maxCoeff() >= num_vertices()) {
+      throw Error(where,
+                  "triangle " + std::to_string(f) + " refers to a vertex that does not exist");
+    }
+    if (face(0) == face(1) || face(1) == face(2) || face(0) == face(2)) {
+      throw Error(where, "triangle " + std::to_string(f) + " repeats a vertex");
+    }
   }
 }
 

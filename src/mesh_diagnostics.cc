@@ -22,8 +22,10 @@ void Record(const Id& id, int max_examples, int* count, std::vector<Id>* example
 
 void RequireVerticesExist(const Mesh& mesh, const std::string& where) {
   for (int f = 0; f < mesh.num_faces(); ++f) {
-    Require(mesh.faces.col(f).minCoeff() >= 0 && mesh.faces.col(f).maxCoeff() < mesh.num_vertices(),
-            where, "triangle " + std::to_string(f) + " refers to a vertex that does not exist");
+    if (mesh.faces.col(f).minCoeff() >= 0 && mesh.faces.col(f).maxCoeff() < mesh.num_vertices()) {
+      continue;
+    }
+    throw Error(where, "triangle " + std::to_string(f) + " refers to a vertex that does not exist");
   }
 }
 

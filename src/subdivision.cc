@@ -20,12 +20,12 @@ double LoopBeta(int valence) {
 
 void RequireManifoldEdges(const MeshEdges& edges, const std::string& where) {
   for (int e = 0; e < edges.num_edges(); ++e) {
-    Require(
-        edges.NumSides(e) <= 2, where,
-        "edge (" + std::to_string(edges.vertices(0, e)) + ", " +
-            std::to_string(edges.vertices(1, e)) + ") is shared by " +
-            std::to_string(edges.NumSides(e)) +
-            " triangles (a non-manifold edge): Loop subdivision needs every edge in at most two");
+    if (edges.NumSides(e) <= 2) continue;
+    throw Error(where, "edge (" + std::to_string(edges.vertices(0, e)) + ", " +
+                           std::to_string(edges.vertices(1, e)) + ") is shared by " +
+                           std::to_string(edges.NumSides(e)) +
+                           " triangles (a non-manifold edge): Loop subdivision needs every edge "
+                           "in at most two");
   }
 }
 
@@ -155,7 +155,12 @@ SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels, const st
   stencil.faces = coarse.faces;
   for (int l = 0; l < levels; ++l) {
     OneLevel level = SubdivideOnce(stencil.num_fine_vertices(), stencil.faces, where);
-    stencil.matrix = (level.matrix * stencil.matrix).eval();
+    if (l == 0) {
+      stencil.matrix = std::move(level.matrix);  // Skips the product with the identity.
+    } else {
+      Eigen::SparseMatrix<double> composed = level.matrix * stencil.matrix;
+      stencil.matrix.swap(composed);
+    }
     stencil.faces = std::move(level.faces);
     stencil.level_edges.push_back(std::move(level.edges));
   }

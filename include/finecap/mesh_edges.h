@@ -33,8 +33,9 @@ struct MeshEdges {
   bool IsBoundary(int e) const { return NumSides(e) == 1; }
 };
 
-// Collects the edges of `faces` by sorting the 3 * num_faces sides on their vertex pair: O(F log
-// F). Vertex ids must be non-negative; the caller validates them against the vertex count.
+// Collects the edges of `faces` by bucketing the 3 * num_faces sides on their smaller vertex, then
+// sorting each bucket: O(F) for bounded valence. Vertex ids must be non-negative; the caller
+// validates them against the vertex count.
 MeshEdges BuildMeshEdges(const Eigen::Matrix3Xi& faces);
 
 }  // namespace finecap
