@@ -1,0 +1,84 @@
+// The solvers of one frame's energy (frame_energy.h). All take the same problem and report the
+// same statistics, so that experiments can set them side by side:
+//
+//  * "ceres" (default): the least-squares form, the similarity's residual blocks plus one linear
+//    residual per pair of neighbours, with hand-written Jacobians; Levenberg-Marquardt with a
+//    sparse Cholesky factorisation (SuiteSparse); each k_s a bounded 1-D parameter block; the
+//    shared work of an evaluation done once in a ceres::EvaluationCallback.
+//  * "gradient_ascent": the paper's conditioned gradient ascent on the scalar energy: a step
+//    factor per k_s that grows while the sign of its derivative repeats and shrinks when it
+//    flips, with capped steps.
+//  * "lbfgs": ceres::GradientProblemSolver (L-BFGS with a line search) on the scalar energy; the
+//    bound |k| <= k_max through the smooth change of variables k = k_max tanh(x / k_max).
+#ifndef FINECAP_SOLVER_H_
+#define FINECAP_SOLVER_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "finecap/frame_energy.h"
+
+namespace finecap {
+
+struct SolverOptions {
+  // "ceres", "gradient_ascent" or "lbfgs".
+  std::string type = "ceres";
+  // Most iterations. Paper (gradient ascent): 150.
+  int max_iterations = 50;
+  // Stop when the energy changes by less than this fraction of its value. Default 1e-6.
+  double function_tolerance = 1e-6;
+  // Threads of Ceres' evaluation and linear algebra; 0 = all cores.
+  int num_threads = 0;
+
+  // Ceres only: trust-region strategy, "levenberg_marquardt" or "dogleg".
+  std::string trust_region = "levenberg_marquardt";
+  // Ceres only: "sparse_normal_cholesky" (SuiteSparse), "iterative_schur"... see the README;
+  // "cgnr" (conjugate gradients on the normal equations, inexact steps) is the iterative option.
+  std::string linear_solver = "sparse_normal_cholesky";
+
+  // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
+  // are scaled from it). Default 0.5 mm.
+  double initial_step = 0.0005;
+  // Gradient ascent only: step factor growth when a derivative keeps its sign, and shrink when
+  // it flips. Defaults 1.2 and 0.5.
+  double step_growth = 1.2;
+  double step_shrink = 0.5;
+  // Gradient ascent only: the largest step of one k_s in one iteration, metres. Default 2 mm.
+  double max_step = 0.002;
+
+  void Check() const;
+};
+
+// One row of a solver's convergence trace.
+struct SolverIteration {
+  int iteration = 0;
+  double energy = 0.0;   // E of the configured energy.
+  double seconds = 0.0;  // Since the start of the solve.
+};
+
+struct SolverSummary {
+  std::string solver;
+  double energy_start = 0.0;  // E = E_sim - w_reg E_reg of the configured energy.
+  double energy_end = 0.0;
+  double ls_cost_start = 0.0;  // 1/2 sum of squared residuals of the least-squares form.
+  double ls_cost_end = 0.0;
+  int iterations = 0;
+  int evaluations = 0;
+  double seconds = 0.0;
+  double seconds_evaluation = 0.0;     // Residuals, Jacobians, energies and gradients.
+  double seconds_linear_solver = 0.0;  // Ceres only.
+  std::string termination;             // Why the solver stopped.
+  std::vector<SolverIteration> trace;
+};
+
+// Maximises the energy over k (one entry per surface Gaussian, metres), starting from *k.
+SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k);
+
+// 1/2 sum of squared residuals of the least-squares form at k (similarity and regulariser).
+double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k);
+
+}  // namespace finecap
+
+#endif  // FINECAP_SOLVER_H_

@@ -1,0 +1,181 @@
+// The least-squares form of the energy as a Ceres problem with hand-written Jacobians.
+#include <memory>
+
+#include <ceres/ceres.h>
+
+#include "solvers/solvers_internal.h"
+
+namespace finecap {
+namespace internal {
+namespace {
+
+// Computes every similarity residual once per evaluation point, before Ceres asks the residual
+// blocks for them: the projections and overlaps are shared between residuals.
+class SharedEvaluation : public ceres::EvaluationCallback {
+ public:
+  SharedEvaluation(SimilarityTerm* term, const Eigen::VectorXd* k, double* seconds)
+      : term_(term), k_(k), seconds_(seconds) {}
+
+  void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override {
+    // A residual-only preparation cannot serve a later Jacobian request at the same point.
+    if (!new_evaluation_point && (have_jacobians_ || !evaluate_jacobians)) return;
+    const Stopwatch clock;
+    term_->PrepareResiduals(*k_, evaluate_jacobians);
+    have_jacobians_ = evaluate_jacobians;
+    *seconds_ += clock.Seconds();
+  }
+
+ private:
+  SimilarityTerm* term_;
+  const Eigen::VectorXd* k_;  // The parameter blocks' memory: Ceres writes each point there.
+  double* seconds_;
+  bool have_jacobians_ = false;
+};
+
+// One residual block of the similarity; the values come from SharedEvaluation.
+class SimilarityBlockCost : public ceres::CostFunction {
+ public:
+  SimilarityBlockCost(const SimilarityTerm& term, int block) : term_(term), block_(block) {
+    const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
+    set_num_residuals(info.num_residuals);
+    mutable_parameter_block_sizes()->assign(info.parameters.size(), 1);
+  }
+
+  bool Evaluate(double const* const* /*parameters*/, double* residuals,
+                double** jacobians) const override {
+    if (jacobians == nullptr) {
+      term_.BlockResiduals(block_, residuals, nullptr);
+      return true;
+    }
+    const int num_parameters = static_cast<int>(parameter_block_sizes().size());
+    thread_local std::vector<double> jacobian;
+    jacobian.resize(static_cast<size_t>(num_residuals()) * num_parameters);
+    term_.BlockResiduals(block_, residuals, jacobian.data());
+    for (int p = 0; p < num_parameters; ++p) {
+      if (jacobians[p] == nullptr) continue;
+      for (int r = 0; r < num_residuals(); ++r) jacobians[p][r] = jacobian[r * num_parameters + p];
+    }
+    return true;
+  }
+
+ private:
+  const SimilarityTerm& term_;
+  int block_;
+};
+
+// r = c (k_a - k_b), or r = c k_a when the neighbour is fixed at 0; c = 2 sqrt(w_reg T) u, so
+// that 1/2 sum r^2 = w_reg E_reg.
+class RegularizerPairCost : public ceres::CostFunction {
+ public:
+  RegularizerPairCost(double coefficient, bool fixed_neighbour) : coefficient_(coefficient) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->assign(fixed_neighbour ? 1 : 2, 1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const bool pair = parameter_block_sizes().size() == 2;
+    residuals[0] = coefficient_ * (parameters[0][0] - (pair ? parameters[1][0] : 0.0));
+    if (jacobians == nullptr) return true;
+    if (jacobians[0] != nullptr) jacobians[0][0] = coefficient_;
+    if (pair && jacobians[1] != nullptr) jacobians[1][0] = -coefficient_;
+    return true;
+  }
+
+ private:
+  double coefficient_;
+};
+
+void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* problem) {
+  const double k_max = energy->options().k_max;
+  for (int s = 0; s < k->size(); ++s) {
+    problem->AddParameterBlock(&(*k)[s], 1);
+    problem->SetParameterLowerBound(&(*k)[s], 0, -k_max);
+    problem->SetParameterUpperBound(&(*k)[s], 0, k_max);
+  }
+  const SimilarityTerm& term = energy->similarity();
+  std::vector<double*> blocks;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    blocks.clear();
+    for (int s : term.residual_blocks()[b].parameters) blocks.push_back(&(*k)[s]);
+    problem->AddResidualBlock(new SimilarityBlockCost(term, b), nullptr, blocks);
+  }
+  const Regularizer& regularizer = energy->regularizer();
+  const double w_reg = energy->options().w_reg;
+  if (w_reg <= 0.0) return;
+  for (const Regularizer::Pair& pair : regularizer.pairs()) {
+    const double coefficient = 2.0 * std::sqrt(w_reg * pair.weight) * regularizer.unit_scale();
+    blocks.assign(1, &(*k)[pair.a]);
+    if (pair.b >= 0) blocks.push_back(&(*k)[pair.b]);
+    problem->AddResidualBlock(new RegularizerPairCost(coefficient, pair.b < 0), nullptr, blocks);
+  }
+}
+
+ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
+  ceres::Solver::Options ceres_options;
+  ceres_options.max_num_iterations = options.max_iterations;
+  ceres_options.function_tolerance = options.function_tolerance;
+  ceres_options.num_threads = options.num_threads > 0
+                                  ? options.num_threads
+                                  : static_cast<int>(std::thread::hardware_concurrency());
+  ceres_options.trust_region_strategy_type = options.trust_region == "dogleg"
+                                                 ? ceres::DOGLEG
+                                                 : ceres::LEVENBERG_MARQUARDT;
+  if (options.linear_solver == "cgnr") {
+    ceres_options.linear_solver_type = ceres::CGNR;
+  } else if (options.linear_solver == "dense_qr") {
+    ceres_options.linear_solver_type = ceres::DENSE_QR;
+  } else {
+    ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    ceres_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  }
+  ceres_options.logging_type = ceres::SILENT;
+  return ceres_options;
+}
+
+class TraceRecorder : public ceres::IterationCallback {
+ public:
+  TraceRecorder(const Stopwatch& clock, SolverSummary* summary)
+      : clock_(clock), summary_(summary) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
+    // Ceres minimises the least-squares cost; the trace records it negated, so that for the
+    // colour similarity it is E itself and for every form larger is better.
+    summary_->trace.push_back({iteration.iteration, -iteration.cost, clock_.Seconds()});
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const Stopwatch& clock_;
+  SolverSummary* summary_;
+};
+
+}  // namespace
+
+void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
+                    SolverSummary* summary) {
+  const Stopwatch clock;
+  double seconds_shared = 0.0;
+  SharedEvaluation shared(&energy->similarity(), k, &seconds_shared);
+  ceres::Problem::Options problem_options;
+  problem_options.evaluation_callback = &shared;
+  ceres::Problem problem(problem_options);
+  AddResiduals(energy, k, &problem);
+
+  ceres::Solver::Options ceres_options = MakeCeresOptions(options);
+  TraceRecorder recorder(clock, summary);
+  ceres_options.callbacks.push_back(&recorder);
+  ceres::Solver::Summary ceres_summary;
+  ceres::Solve(ceres_options, &problem, &ceres_summary);
+  VLOG(1) << ceres_summary.FullReport();
+
+  summary->iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
+  summary->evaluations = ceres_summary.num_residual_evaluations;
+  summary->termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
+  summary->seconds = clock.Seconds();
+  summary->seconds_evaluation = ceres_summary.residual_evaluation_time_in_seconds +
+                                ceres_summary.jacobian_evaluation_time_in_seconds;
+  summary->seconds_linear_solver = ceres_summary.linear_solver_time_in_seconds;
+}
+
+}  // namespace internal
+}  // namespace finecap
