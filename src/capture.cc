@@ -1,6 +1,7 @@
 #include "finecap/capture.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>

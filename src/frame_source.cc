@@ -1,6 +1,7 @@
 #include "finecap/frame_source.h"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <map>
 

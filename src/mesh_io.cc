@@ -1,6 +1,7 @@
 #include "finecap/mesh_io.h"
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 #include <assimp/postprocess.h>
