@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 
 #include "finecap/error.h"
@@ -175,8 +176,13 @@ bool IsFinite(const ImageGaussian& g) {
          std::isfinite(g.color[1]) && std::isfinite(g.color[2]);
 }
 
-// Size classes are the binary exponents of sigma: sigma in [2^k, 2^(k+1)).
-int SizeExponent(float sigma) { return std::ilogb(sigma); }
+// Size classes are the binary exponents of sigma: sigma in [2^k, 2^(k+1)). Read from the bits
+// of the (positive) float: std::ilogb is an out-of-line library call, once per Gaussian.
+int SizeExponent(float sigma) {
+  uint32_t bits;
+  std::memcpy(&bits, &sigma, sizeof(bits));
+  return static_cast<int>((bits >> 23) & 0xffu) - 127;
+}
 
 }  // namespace
 
@@ -198,9 +204,12 @@ ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
     : width_(width), height_(height), color_space_(color_space) {
   Require(width >= 0 && height >= 0, where, "negative image size");
   for (const ImageGaussian& g : gaussians) {
-    Require(IsFinite(g), where, "image Gaussian with a non-finite mean or colour");
-    Require(std::isfinite(g.sigma) && g.sigma > 0.0f, where,
-            "image Gaussian with sigma " + std::to_string(g.sigma) + "; must be positive");
+    // Plain ifs: the message is built only on failure, not once per Gaussian.
+    if (!IsFinite(g)) throw Error(where, "image Gaussian with a non-finite mean or colour");
+    if (!(std::isfinite(g.sigma) && g.sigma > 0.0f)) {
+      throw Error(where,
+                  "image Gaussian with sigma " + std::to_string(g.sigma) + "; must be positive");
+    }
   }
   if (gaussians.empty()) return;
 
