@@ -52,28 +52,20 @@ const HueTable& GetHueTable() {
 }
 
 Eigen::Vector3f HsvCone(int b, int g, int r, const HueTable& table) {
-  const int max = std::max({b, g, r});
-  const int chroma = max - std::min({b, g, r});
+  const int max = std::max(std::max(b, g), r);
+  const int chroma = max - std::min(std::min(b, g), r);
   const float value = max * kInv255;
   if (chroma == 0) return Eigen::Vector3f(0.0f, 0.0f, value);
 
   // Hexagonal hue: the sector is named by the largest channel (red 0, green 120, blue 240
-  // degrees), the offset inside it by the difference of the other two.
-  constexpr float kCos120 = -0.5f, kSin120 = 0.866025403784438647f;
-  float cos_base = 1.0f, sin_base = 0.0f;
-  int offset;
-  if (max == r) {
-    offset = g - b;
-  } else if (max == g) {
-    offset = b - r;
-    cos_base = kCos120;
-    sin_base = kSin120;
-  } else {
-    offset = r - g;
-    cos_base = kCos120;
-    sin_base = -kSin120;
-  }
+  // degrees), the offset inside it by the difference of the other two. Selects, not branches:
+  // the sector of a textured image's pixels is unpredictable.
+  static constexpr float kCosBase[3] = {1.0f, -0.5f, -0.5f};
+  static constexpr float kSinBase[3] = {0.0f, 0.866025403784438647f, -0.866025403784438647f};
+  const int sector = (max == r) ? 0 : (max == g ? 1 : 2);
+  const int offset = (max == r) ? g - b : (max == g ? b - r : r - g);
   const std::array<float, 2> p = table.Lookup(chroma, offset);
+  const float cos_base = kCosBase[sector], sin_base = kSinBase[sector];
   return Eigen::Vector3f(cos_base * p[0] - sin_base * p[1], sin_base * p[0] + cos_base * p[1],
                          value);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 
 #include "finecap/error.h"
@@ -175,8 +176,13 @@ bool IsFinite(const ImageGaussian& g) {
          std::isfinite(g.color[1]) && std::isfinite(g.color[2]);
 }
 
-// Size classes are the binary exponents of sigma: sigma in [2^k, 2^(k+1)).
-int SizeExponent(float sigma) { return std::ilogb(sigma); }
+// Size classes are the binary exponents of sigma: sigma in [2^k, 2^(k+1)). Read from the bits
+// of the (positive) float: std::ilogb is an out-of-line library call, once per Gaussian.
+int SizeExponent(float sigma) {
+  uint32_t bits;
+  std::memcpy(&bits, &sigma, sizeof(bits));
+  return static_cast<int>((bits >> 23) & 0xffu) - 127;
+}
 
 }  // namespace
 
@@ -198,13 +204,15 @@ ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
     : width_(width), height_(height), color_space_(color_space) {
   Require(width >= 0 && height >= 0, where, "negative image size");
   for (const ImageGaussian& g : gaussians) {
-    Require(IsFinite(g), where, "image Gaussian with a non-finite mean or colour");
-    Require(std::isfinite(g.sigma) && g.sigma > 0.0f, where,
-            "image Gaussian with sigma " + std::to_string(g.sigma) + "; must be positive");
+    // Plain ifs: the message is built only on failure, not once per Gaussian.
+    if (!IsFinite(g)) throw Error(where, "image Gaussian with a non-finite mean or colour");
+    if (!(std::isfinite(g.sigma) && g.sigma > 0.0f)) {
+      throw Error(where,
+                  "image Gaussian with sigma " + std::to_string(g.sigma) + "; must be positive");
+    }
   }
   if (gaussians.empty()) return;
 
-  // Group by size class, and inside a class by grid cell: a counting sort over (class, cell).
   int min_exponent = SizeExponent(gaussians[0].sigma), max_exponent = min_exponent;
   for (const ImageGaussian& g : gaussians) {
     min_exponent = std::min(min_exponent, SizeExponent(g.sigma));
@@ -214,57 +222,65 @@ ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
   for (int i = 0; i < static_cast<int>(gaussians.size()); ++i) {
     members[SizeExponent(gaussians[i].sigma) - min_exponent].push_back(i);
   }
-
   gaussians_.reserve(gaussians.size());
   for (int k = 0; k < static_cast<int>(members.size()); ++k) {
-    if (members[k].empty()) continue;
-    SizeClass size_class;
-    size_class.begin = static_cast<int>(gaussians_.size());
-    float min_x = gaussians[members[k][0]].x, max_x = min_x;
-    float min_y = gaussians[members[k][0]].y, max_y = min_y;
-    for (int i : members[k]) {
-      const ImageGaussian& g = gaussians[i];
-      size_class.max_sigma = std::max(size_class.max_sigma, g.sigma);
-      min_x = std::min(min_x, g.x);
-      max_x = std::max(max_x, g.x);
-      min_y = std::min(min_y, g.y);
-      max_y = std::max(max_y, g.y);
-    }
-    // A cell the side of the class's smallest square holds about one quad-tree leaf; a class
-    // that is sparse over its extent gets coarser cells, keeping the grid within ~4 cells per
-    // Gaussian.
-    const double max_cells = 4.0 * members[k].size() + 64.0;
-    size_class.cell = std::ldexp(1.0, min_exponent + k + 1);
-    while ((double(max_x - min_x) / size_class.cell + 1.0) *
-               (double(max_y - min_y) / size_class.cell + 1.0) >
-           max_cells) {
-      size_class.cell *= 2.0;
-    }
-    size_class.origin_x = min_x;
-    size_class.origin_y = min_y;
-    size_class.cols = static_cast<int>((max_x - min_x) / size_class.cell) + 1;
-    size_class.rows = static_cast<int>((max_y - min_y) / size_class.cell) + 1;
-
-    auto cell_of = [&size_class](const ImageGaussian& g) {
-      const int col = std::min(size_class.cols - 1,
-                               static_cast<int>((g.x - size_class.origin_x) / size_class.cell));
-      const int row = std::min(size_class.rows - 1,
-                               static_cast<int>((g.y - size_class.origin_y) / size_class.cell));
-      return row * size_class.cols + col;
-    };
-    const int num_cells = size_class.cols * size_class.rows;
-    std::vector<int> cell_count(num_cells + 1, 0);
-    for (int i : members[k]) ++cell_count[cell_of(gaussians[i]) + 1];
-    size_class.cell_begin.resize(num_cells + 1);
-    size_class.cell_begin[0] = size_class.begin;
-    for (int c = 0; c < num_cells; ++c) {
-      size_class.cell_begin[c + 1] = size_class.cell_begin[c] + cell_count[c + 1];
-    }
-    std::vector<int> next(size_class.cell_begin.begin(), size_class.cell_begin.end() - 1);
-    gaussians_.resize(gaussians_.size() + members[k].size());
-    for (int i : members[k]) gaussians_[next[cell_of(gaussians[i])]++] = gaussians[i];
-    classes_.push_back(std::move(size_class));
+    if (!members[k].empty()) AppendSizeClass(gaussians, members[k], min_exponent + k);
   }
+}
+
+void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all,
+                                     const std::vector<int>& members, int exponent) {
+  SizeClass size_class;
+  size_class.begin = static_cast<int>(gaussians_.size());
+  float min_x = all[members[0]].x, max_x = min_x;
+  float min_y = all[members[0]].y, max_y = min_y;
+  for (int i : members) {
+    size_class.max_sigma = std::max(size_class.max_sigma, all[i].sigma);
+    min_x = std::min(min_x, all[i].x);
+    max_x = std::max(max_x, all[i].x);
+    min_y = std::min(min_y, all[i].y);
+    max_y = std::max(max_y, all[i].y);
+  }
+  // A cell the side of the class's smallest square holds about one quad-tree leaf; a class that
+  // is sparse over its extent gets coarser cells, keeping the grid within ~4 cells per Gaussian.
+  const double max_cells = 4.0 * members.size() + 64.0;
+  size_class.cell = std::ldexp(1.0, exponent + 1);
+  while ((double(max_x - min_x) / size_class.cell + 1.0) *
+             (double(max_y - min_y) / size_class.cell + 1.0) >
+         max_cells) {
+    size_class.cell *= 2.0;
+  }
+  size_class.origin_x = min_x;
+  size_class.origin_y = min_y;
+  size_class.cols = static_cast<int>((max_x - min_x) / size_class.cell) + 1;
+  size_class.rows = static_cast<int>((max_y - min_y) / size_class.cell) + 1;
+
+  // Counting sort by cell: each cell's Gaussians, and each grid row's, end up contiguous.
+  const int num_cells = size_class.cols * size_class.rows;
+  size_class.cell_begin.assign(num_cells + 1, 0);
+  for (int i : members) ++size_class.cell_begin[size_class.CellOf(all[i]) + 1];
+  size_class.cell_begin[0] = size_class.begin;
+  for (int c = 0; c < num_cells; ++c) size_class.cell_begin[c + 1] += size_class.cell_begin[c];
+  std::vector<int> next(size_class.cell_begin.begin(), size_class.cell_begin.end() - 1);
+  gaussians_.resize(gaussians_.size() + members.size());
+  for (int i : members) gaussians_[next[size_class.CellOf(all[i])]++] = all[i];
+  classes_.push_back(std::move(size_class));
+}
+
+int ImageGaussians::SizeClass::CellOf(const ImageGaussian& g) const {
+  const int col = std::min(cols - 1, static_cast<int>((g.x - origin_x) / cell));
+  const int row = std::min(rows - 1, static_cast<int>((g.y - origin_y) / cell));
+  return row * cols + col;
+}
+
+std::pair<int, int> ImageGaussians::SizeClass::CellRange(double low, double high, double origin,
+                                                         int count) const {
+  // Clamped in double first: a far-away query must not overflow the conversion to int.
+  const auto clamped_cell = [&](double coordinate) {
+    return static_cast<int>(
+        std::clamp(std::floor((coordinate - origin) / cell), -1.0, static_cast<double>(count)));
+  };
+  return {std::max(0, clamped_cell(low)), std::min(count - 1, clamped_cell(high))};
 }
 
 void ImageGaussians::CollectNear(const Eigen::Vector2d& point, double base, double sigma_factor,
@@ -274,25 +290,13 @@ void ImageGaussians::CollectNear(const Eigen::Vector2d& point, double base, doub
     const double radius_squared = base + sigma_factor * max_sigma * max_sigma;
     if (!(radius_squared >= 0.0)) continue;
     const double radius = std::sqrt(radius_squared);
-    // Cell ranges in double first: a far-away query must not overflow the int conversion.
-    const auto clamp_cell = [](double value, int count) {
-      return static_cast<int>(std::clamp(std::floor(value), -1.0, double(count)));
-    };
-    const int col_begin = std::max(
-        0,
-        clamp_cell((point.x() - radius - size_class.origin_x) / size_class.cell, size_class.cols));
-    const int col_last = std::min(
-        size_class.cols - 1,
-        clamp_cell((point.x() + radius - size_class.origin_x) / size_class.cell, size_class.cols));
-    const int row_begin = std::max(
-        0,
-        clamp_cell((point.y() - radius - size_class.origin_y) / size_class.cell, size_class.rows));
-    const int row_last = std::min(
-        size_class.rows - 1,
-        clamp_cell((point.y() + radius - size_class.origin_y) / size_class.cell, size_class.rows));
-    for (int row = row_begin; row <= row_last; ++row) {
+    const auto [col_first, col_last] = size_class.CellRange(point.x() - radius, point.x() + radius,
+                                                            size_class.origin_x, size_class.cols);
+    const auto [row_first, row_last] = size_class.CellRange(point.y() - radius, point.y() + radius,
+                                                            size_class.origin_y, size_class.rows);
+    for (int row = row_first; row <= row_last; ++row) {
       // The cells of one grid row are contiguous in gaussians_.
-      const int begin = size_class.cell_begin[row * size_class.cols + col_begin];
+      const int begin = size_class.cell_begin[row * size_class.cols + col_first];
       const int end = size_class.cell_begin[row * size_class.cols + col_last + 1];
       for (int i = begin; i < end; ++i) {
         const ImageGaussian& g = gaussians_[i];

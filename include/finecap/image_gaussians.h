@@ -22,12 +22,13 @@
 // Speed. The per-square sums of colours, squared colour norms and pixel counts are kept in a
 // pyramid whose finest level holds the smallest squares; every quad-tree square is one node of
 // it, so each split test is O(1), as with summed-area tables, but the pyramid holds only 4/3 of a
-// node per smallest square (a few MB) instead of one per pixel. A 1004 x 1004 image builds in a
-// few milliseconds.
+// node per smallest square (a few MB) instead of one per pixel. A textured 1004 x 1004 image
+// (~40k leaves) builds in about 10 ms on one core, its HSV conversion included.
 #ifndef FINECAP_IMAGE_GAUSSIANS_H_
 #define FINECAP_IMAGE_GAUSSIANS_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -121,7 +122,18 @@ class ImageGaussians {
     int rows = 0;
     // gaussians_[cell_begin[c] .. cell_begin[c + 1]) lie in cell c = row * cols + col.
     std::vector<int> cell_begin;
+
+    // The cell holding g's mean.
+    int CellOf(const ImageGaussian& g) const;
+    // First and last cell, along an axis with `count` cells from `origin`, that the coordinates
+    // [low, high] touch; first > last when none.
+    std::pair<int, int> CellRange(double low, double high, double origin, int count) const;
   };
+
+  // Appends the Gaussians all[members], whose sigmas lie in [2^exponent, 2^(exponent+1)), as
+  // a new size class.
+  void AppendSizeClass(const std::vector<ImageGaussian>& all, const std::vector<int>& members,
+                       int exponent);
 
   // Appends the Gaussians with |mean - point|^2 <= base + sigma_factor * sigma_i^2.
   void CollectNear(const Eigen::Vector2d& point, double base, double sigma_factor,
