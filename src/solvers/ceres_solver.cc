@@ -1,90 +1,15 @@
 // The least-squares form of the energy as a Ceres problem with hand-written Jacobians.
 #include <memory>
+#include <thread>
 
 #include <ceres/ceres.h>
 
+#include "finecap/ceres_cost_functions.h"
 #include "solvers/solvers_internal.h"
 
 namespace finecap {
 namespace internal {
 namespace {
-
-// Computes every similarity residual once per evaluation point, before Ceres asks the residual
-// blocks for them: the projections and overlaps are shared between residuals.
-class SharedEvaluation : public ceres::EvaluationCallback {
- public:
-  SharedEvaluation(SimilarityTerm* term, const Eigen::VectorXd* k, double* seconds)
-      : term_(term), k_(k), seconds_(seconds) {}
-
-  void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override {
-    // A residual-only preparation cannot serve a later Jacobian request at the same point.
-    if (!new_evaluation_point && (have_jacobians_ || !evaluate_jacobians)) return;
-    const Stopwatch clock;
-    term_->PrepareResiduals(*k_, evaluate_jacobians);
-    have_jacobians_ = evaluate_jacobians;
-    *seconds_ += clock.Seconds();
-  }
-
- private:
-  SimilarityTerm* term_;
-  const Eigen::VectorXd* k_;  // The parameter blocks' memory: Ceres writes each point there.
-  double* seconds_;
-  bool have_jacobians_ = false;
-};
-
-// One residual block of the similarity; the values come from SharedEvaluation.
-class SimilarityBlockCost : public ceres::CostFunction {
- public:
-  SimilarityBlockCost(const SimilarityTerm& term, int block) : term_(term), block_(block) {
-    const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
-    set_num_residuals(info.num_residuals);
-    mutable_parameter_block_sizes()->assign(info.parameters.size(), 1);
-  }
-
-  bool Evaluate(double const* const* /*parameters*/, double* residuals,
-                double** jacobians) const override {
-    if (jacobians == nullptr) {
-      term_.BlockResiduals(block_, residuals, nullptr);
-      return true;
-    }
-    const int num_parameters = static_cast<int>(parameter_block_sizes().size());
-    thread_local std::vector<double> jacobian;
-    jacobian.resize(static_cast<size_t>(num_residuals()) * num_parameters);
-    term_.BlockResiduals(block_, residuals, jacobian.data());
-    for (int p = 0; p < num_parameters; ++p) {
-      if (jacobians[p] == nullptr) continue;
-      for (int r = 0; r < num_residuals(); ++r) jacobians[p][r] = jacobian[r * num_parameters + p];
-    }
-    return true;
-  }
-
- private:
-  const SimilarityTerm& term_;
-  int block_;
-};
-
-// r = c (k_a - k_b), or r = c k_a when the neighbour is fixed at 0; c = 2 sqrt(w_reg T) u, so
-// that 1/2 sum r^2 = w_reg E_reg.
-class RegularizerPairCost : public ceres::CostFunction {
- public:
-  RegularizerPairCost(double coefficient, bool fixed_neighbour) : coefficient_(coefficient) {
-    set_num_residuals(1);
-    mutable_parameter_block_sizes()->assign(fixed_neighbour ? 1 : 2, 1);
-  }
-
-  bool Evaluate(double const* const* parameters, double* residuals,
-                double** jacobians) const override {
-    const bool pair = parameter_block_sizes().size() == 2;
-    residuals[0] = coefficient_ * (parameters[0][0] - (pair ? parameters[1][0] : 0.0));
-    if (jacobians == nullptr) return true;
-    if (jacobians[0] != nullptr) jacobians[0][0] = coefficient_;
-    if (pair && jacobians[1] != nullptr) jacobians[1][0] = -coefficient_;
-    return true;
-  }
-
- private:
-  double coefficient_;
-};
 
 void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* problem) {
   const double k_max = energy->options().k_max;
@@ -118,9 +43,8 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
   ceres_options.num_threads = options.num_threads > 0
                                   ? options.num_threads
                                   : static_cast<int>(std::thread::hardware_concurrency());
-  ceres_options.trust_region_strategy_type = options.trust_region == "dogleg"
-                                                 ? ceres::DOGLEG
-                                                 : ceres::LEVENBERG_MARQUARDT;
+  ceres_options.trust_region_strategy_type =
+      options.trust_region == "dogleg" ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   if (options.linear_solver == "cgnr") {
     ceres_options.linear_solver_type = ceres::CGNR;
   } else if (options.linear_solver == "dense_qr") {
@@ -155,7 +79,7 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
                     SolverSummary* summary) {
   const Stopwatch clock;
   double seconds_shared = 0.0;
-  SharedEvaluation shared(&energy->similarity(), k, &seconds_shared);
+  SharedEvaluationCallback shared(&energy->similarity(), k, &seconds_shared);
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &shared;
   ceres::Problem problem(problem_options);

@@ -1,0 +1,124 @@
+#include "finecap/solver.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include "energy_fixture.h"
+#include "finecap/ceres_cost_functions.h"
+
+namespace finecap {
+namespace {
+
+EnergyOptions Options(const std::string& similarity, const std::string& overlap) {
+  EnergyOptions options;
+  options.similarity = similarity;
+  options.overlap = overlap;
+  options.k_max = 0.01;
+  options.w_reg = 1e-3;
+  return options;
+}
+
+bool CheckGradient(const ceres::CostFunction& cost, const std::vector<double>& values,
+                   std::string* error) {
+  ceres::NumericDiffOptions numeric;
+  // k is in metres and often 0: the checker (Ridders) starts from an absolute step of this size.
+  numeric.ridders_relative_initial_step_size = 1e-5;
+  const ceres::GradientChecker checker(
+      &cost, static_cast<const std::vector<const ceres::Manifold*>*>(nullptr), numeric);
+  std::vector<const double*> parameters;
+  for (const double& value : values) parameters.push_back(&value);
+  ceres::GradientChecker::ProbeResults results;
+  const bool ok = checker.Probe(parameters.data(), 1e-6, &results);
+  *error = results.error_log;
+  return ok;
+}
+
+class CeresCostTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+// Every kind of least-squares residual, checked by ceres::GradientChecker against numeric
+// differences, including cameras at 75 degrees (near grazing).
+TEST_P(CeresCostTest, SimilarityBlocksPassTheGradientChecker) {
+  const auto [similarity, overlap] = GetParam();
+  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options(similarity, overlap));
+  Eigen::VectorXd k(energy.num_parameters());
+  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  SimilarityTerm& term = energy.similarity();
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  int checked = 0, failed = 0;
+  for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 40)) {
+    const IsolatedSimilarityBlockCost cost(&term, b, k);
+    std::vector<double> values;
+    for (int s : term.residual_blocks()[b].parameters) values.push_back(k[s]);
+    std::string error;
+    if (!CheckGradient(cost, values, &error)) {
+      ++failed;
+      ADD_FAILURE() << "block " << b << ": " << error;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 20);
+  EXPECT_EQ(failed, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllForms, CeresCostTest,
+                         ::testing::Combine(::testing::Values("paper", "surface_color"),
+                                            ::testing::Values("printed", "exact")),
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + "_" + std::get<1>(info.param);
+                         });
+
+TEST(CeresCostTest, RegularizerPairsPassTheGradientChecker) {
+  std::string error;
+  EXPECT_TRUE(CheckGradient(RegularizerPairCost(3.5, false), {0.004, -0.002}, &error)) << error;
+  EXPECT_TRUE(CheckGradient(RegularizerPairCost(3.5, true), {0.004}, &error)) << error;
+}
+
+class SolverTest : public ::testing::TestWithParam<std::string> {};
+
+// Every solver raises the energy from the start, keeps |k| <= k_max, and reports statistics
+// that agree with the energy it returns.
+TEST_P(SolverTest, ImprovesTheEnergyWithinBounds) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.5, -0.5}, 3, 13);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("surface_color", "printed"));
+  SolverOptions options;
+  options.type = GetParam();
+  options.max_iterations = 30;
+  Eigen::VectorXd k = Eigen::VectorXd::Constant(energy.num_parameters(), 0.004);
+  const SolverSummary summary = Solve(&energy, options, &k);
+  EXPECT_EQ(summary.solver, GetParam());
+  EXPECT_GT(summary.energy_end, summary.energy_start);
+  EXPECT_LT(summary.ls_cost_end, summary.ls_cost_start);
+  EXPECT_DOUBLE_EQ(summary.energy_end, energy.Evaluate(k, nullptr));
+  EXPECT_LE(k.cwiseAbs().maxCoeff(), energy.options().k_max + 1e-12);
+  EXPECT_GT(summary.iterations, 0);
+  EXPECT_FALSE(summary.trace.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(AllSolvers, SolverTest,
+                         ::testing::Values("ceres", "gradient_ascent", "lbfgs"));
+
+// For the colour similarity the least-squares cost is exactly -E: Ceres and L-BFGS, which
+// optimise the two forms, must agree on the optimum.
+TEST(SolverTest, CeresAndLbfgsReachTheSameOptimum) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.6}, 3, 23);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("surface_color", "printed"));
+  SolverOptions options;
+  options.max_iterations = 200;
+  options.function_tolerance = 1e-12;
+  Eigen::VectorXd k_ceres = Eigen::VectorXd::Zero(energy.num_parameters());
+  Eigen::VectorXd k_lbfgs = k_ceres;
+  options.type = "ceres";
+  const SolverSummary ceres = Solve(&energy, options, &k_ceres);
+  options.type = "lbfgs";
+  const SolverSummary lbfgs = Solve(&energy, options, &k_lbfgs);
+  EXPECT_NEAR(ceres.ls_cost_end, -ceres.energy_end, 1e-12 * std::abs(ceres.energy_end));
+  EXPECT_NEAR(ceres.energy_end, lbfgs.energy_end, 1e-6 * std::abs(ceres.energy_end));
+  EXPECT_LT((k_ceres - k_lbfgs).cwiseAbs().maxCoeff(), 1e-4);
+}
+
+}  // namespace
+}  // namespace finecap
