@@ -306,26 +306,13 @@ class Shader {
   Eigen::Matrix3Xd normals_;
 };
 
-// Writes one output pixel: the mean of its samples (`sum` / `samples`, RGB in [0, 1]) plus
-// sensor noise, rounded and saturated to 8-bit BGR. Each row draws its noise from its own seeded
-// generator, so the image does not depend on how rows are shared among threads.
-class PixelWriter {
- public:
-  PixelWriter(const RenderOptions& options, int row)
-      : sigma_(options.noise_sigma), rng_(options.noise_seed * 1000003ull + row + 1) {}
-
-  void Write(const Eigen::Vector3f& mean_rgb, cv::Vec3b* bgr) {
-    for (int channel = 0; channel < 3; ++channel) {
-      double value = 255.0 * mean_rgb(channel);
-      if (sigma_ > 0.0) value += rng_.gaussian(sigma_);
-      (*bgr)[2 - channel] = cv::saturate_cast<uchar>(value);
-    }
+// Writes one output pixel: the mean of its samples, RGB in [0, 1], rounded and saturated to
+// 8-bit BGR.
+void WritePixel(const Eigen::Vector3f& mean_rgb, cv::Vec3b* bgr) {
+  for (int channel = 0; channel < 3; ++channel) {
+    (*bgr)[2 - channel] = cv::saturate_cast<uchar>(255.0f * mean_rgb(channel));
   }
-
- private:
-  double sigma_;
-  cv::RNG rng_;
-};
+}
 
 }  // namespace
 
@@ -380,7 +367,6 @@ cv::Mat RenderColor(const Camera& camera, const Mesh& mesh, const SurfaceAppeara
       [&](const SampleBand& band) {
         for (int y = band.first_row / s; y < (band.first_row + band.rows) / s; ++y) {
           cv::Vec3b* row = image.ptr<cv::Vec3b>(y);
-          PixelWriter writer(options, y);
           for (int x = 0; x < camera.width; ++x) {
             Eigen::Vector3f sum = Eigen::Vector3f::Zero();
             for (int sy = y * s; sy < (y + 1) * s; ++sy) {
@@ -396,11 +382,28 @@ cv::Mat RenderColor(const Camera& camera, const Mesh& mesh, const SurfaceAppeara
                            .cast<float>();
               }
             }
-            writer.Write(sum * inverse_samples, &row[x]);
+            WritePixel(sum * inverse_samples, &row[x]);
           }
         }
       });
+  AddSensorNoise(options.noise_sigma, options.noise_seed, &image);
   return image;
+}
+
+void AddSensorNoise(double sigma, std::uint64_t seed, cv::Mat* image) {
+  Require(std::isfinite(sigma) && sigma >= 0.0, kWhere, "the noise sigma must be >= 0");
+  Require(image->depth() == CV_8U, kWhere, "sensor noise needs an 8-bit image");
+  if (sigma == 0.0) return;
+  const int values_per_row = image->cols * image->channels();
+#pragma omp parallel for
+  for (int y = 0; y < image->rows; ++y) {
+    // One generator per row: the noise does not depend on how rows are shared among threads.
+    cv::RNG rng(seed * 1000003ull + y + 1);
+    uchar* row = image->ptr<uchar>(y);
+    for (int i = 0; i < values_per_row; ++i) {
+      row[i] = cv::saturate_cast<uchar>(row[i] + rng.gaussian(sigma));
+    }
+  }
 }
 
 cv::Mat RenderNormals(const Camera& camera, const Mesh& mesh, const RenderOptions& options) {

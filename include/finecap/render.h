@@ -100,6 +100,11 @@ cv::Mat RenderColor(const Camera& camera, const Mesh& mesh, const SurfaceAppeara
 cv::Mat RenderNormals(const Camera& camera, const Mesh& mesh,
                       const RenderOptions& options = RenderOptions());
 
+// Adds independent Gaussian noise of standard deviation `sigma` (grey levels) to every value of
+// an 8-bit image, rounding and saturating; the same seed gives the same noise. Throws Error for a
+// negative sigma or an image that is not 8-bit.
+void AddSensorNoise(double sigma, std::uint64_t seed, cv::Mat* image);
+
 }  // namespace finecap
 
 #endif  // FINECAP_RENDER_H_
