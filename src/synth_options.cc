@@ -82,6 +82,9 @@ RenderOptions SynthOptions::DefaultRenderOptions() {
   RenderOptions render;
   render.supersampling = 3;
   render.shade = true;
+  // Bright enough that the sides turned away from the light keep their texture.
+  render.ambient = 0.5;
+  render.diffuse = 0.6;
   render.background = Eigen::Vector3d::Constant(0.12);
   return render;
 }

@@ -46,7 +46,7 @@ std::vector<Rgb> MakePalette(std::mt19937_64& rng, int size) {
   std::vector<Rgb> palette;
   for (int i = 0; i < size; ++i) {
     const double hue = first_hue + 0.618034 * i + 0.08 * unit(rng);
-    palette.push_back(HsvToRgb(hue, 0.45 + 0.5 * unit(rng), 0.3 + 0.65 * unit(rng)));
+    palette.push_back(HsvToRgb(hue, 0.4 + 0.5 * unit(rng), 0.45 + 0.55 * unit(rng)));
   }
   return palette;
 }

@@ -181,7 +181,8 @@ struct SynthOptions {
   RigOptions cameras;
   // How images are rendered (supersampling, shading, sensor noise, background). The noise seed
   // of each image is derived from `seed`, the frame and the camera together with
-  // render.noise_seed. Default: supersampling 3, shading on, background dark grey.
+  // render.noise_seed. Default: supersampling 3, shading on (ambient 0.5, diffuse 0.6),
+  // background dark grey.
   RenderOptions render = DefaultRenderOptions();
 
   // Seed of every random choice (texture, misalignment, calibration and sensor noise). Default 1.
