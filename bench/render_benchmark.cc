@@ -1,0 +1,105 @@
+// Rendering cost of one capture frame: eight 1004 x 1004 cameras on a ring around a textured
+// ~40k-triangle subject, the size of the synthetic skirt captures.
+#include <cmath>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <Eigen/Geometry>
+
+#include "finecap/render.h"
+
+namespace finecap {
+namespace {
+
+// A closed lat-long sphere of radius 0.4 m at the origin, 2 * rings * segments triangles.
+Mesh MakeSubject(int rings, int segments) {
+  Mesh mesh;
+  mesh.vertices.resize(3, (rings + 1) * segments);
+  for (int i = 0; i <= rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const double theta = M_PI * i / rings;
+      const double phi = 2.0 * M_PI * j / segments;
+      mesh.vertices.col(i * segments + j) =
+          0.4 * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                std::sin(theta) * std::sin(phi));
+    }
+  }
+  std::vector<Eigen::Vector3i> faces;
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const int a = i * segments + j;
+      const int b = i * segments + (j + 1) % segments;
+      faces.emplace_back(a, b, a + segments);
+      faces.emplace_back(b, b + segments, a + segments);
+    }
+  }
+  mesh.faces.resize(3, faces.size());
+  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.col(f) = faces[f];
+  return mesh;
+}
+
+std::vector<Camera> MakeRing(int count) {
+  std::vector<Camera> cameras;
+  for (int c = 0; c < count; ++c) {
+    const double angle = 2.0 * M_PI * c / count;
+    const Eigen::Vector3d center(3.0 * std::cos(angle), 0.2, 3.0 * std::sin(angle));
+    const Eigen::Vector3d z = (-center).normalized();
+    const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitY()).normalized();
+    Camera camera;
+    camera.name = "cam" + std::to_string(c);
+    camera.width = camera.height = 1004;
+    camera.K << 1000.0, 0.0, 501.5, 0.0, 1000.0, 501.5, 0.0, 0.0, 1.0;
+    camera.R.row(0) = x;
+    camera.R.row(1) = z.cross(x);
+    camera.R.row(2) = z;
+    camera.t = -camera.R * center;
+    cameras.push_back(camera);
+  }
+  return cameras;
+}
+
+SurfaceAppearance MakeTexturedAppearance(const Mesh& mesh) {
+  SurfaceAppearance appearance;
+  appearance.texture = cv::Mat(1024, 2048, CV_8UC3);
+  cv::randu(appearance.texture, cv::Scalar::all(0), cv::Scalar::all(255));
+  appearance.corner_uvs.resize(2, 3 * mesh.num_faces());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d p = mesh.vertices.col(mesh.faces(c, f));
+      appearance.corner_uvs.col(3 * f + c) = Eigen::Vector2d(p.x() + 0.5, p.y() + 0.5);
+    }
+  }
+  return appearance;
+}
+
+void BM_RenderColorEightCameras(benchmark::State& state) {
+  const Mesh mesh = MakeSubject(100, 200);
+  const std::vector<Camera> cameras = MakeRing(8);
+  const SurfaceAppearance appearance = MakeTexturedAppearance(mesh);
+  RenderOptions options;
+  options.supersampling = static_cast<int>(state.range(0));
+  options.shade = true;
+  for (auto _ : state) {
+    for (const Camera& camera : cameras) {
+      benchmark::DoNotOptimize(RenderColor(camera, mesh, appearance, options).data);
+    }
+  }
+  state.counters["triangles"] = mesh.num_faces();
+}
+BENCHMARK(BM_RenderColorEightCameras)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_RenderDepthEightCameras(benchmark::State& state) {
+  const Mesh mesh = MakeSubject(100, 200);
+  const std::vector<Camera> cameras = MakeRing(8);
+  for (auto _ : state) {
+    for (const Camera& camera : cameras) {
+      benchmark::DoNotOptimize(RenderDepth(camera, mesh).depth.data);
+    }
+  }
+}
+BENCHMARK(BM_RenderDepthEightCameras)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace finecap
+
+BENCHMARK_MAIN();

@@ -1,0 +1,118 @@
+// Validation of the synthetic capture options.
+#include <cmath>
+#include <string>
+
+#include "finecap/error.h"
+#include "finecap/synth.h"
+
+namespace finecap {
+namespace {
+
+void RequireFinite(double value, const std::string& where) {
+  Require(std::isfinite(value), where, "must be a finite number");
+}
+
+void RequireRange(double value, double low, double high, const std::string& where) {
+  RequireFinite(value, where);
+  Require(value >= low && value <= high, where,
+          "is " + std::to_string(value) + " but must lie in [" + std::to_string(low) + ", " +
+              std::to_string(high) + "]");
+}
+
+bool IsPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
+}  // namespace
+
+void FoldComponent::Check(const std::string& where) const {
+  RequireRange(amplitude, -0.1, 0.1, where + ".amplitude");
+  RequireRange(wavelength, 0.01, 2.0, where + ".wavelength");
+  RequireFinite(orientation, where + ".orientation");
+  RequireFinite(phase, where + ".phase");
+  RequireFinite(drift, where + ".drift");
+  Require(profile == "sine" || profile == "ridge", where + ".profile",
+          "is '" + profile + "' but must be 'sine' or 'ridge'");
+}
+
+void SkirtOptions::Check() const {
+  const std::string where = "synth.skirt.";
+  RequireRange(waist_radius, 0.01, 5.0, where + "waist_radius");
+  RequireRange(hem_radius, waist_radius, 5.0, where + "hem_radius");
+  RequireRange(length, 0.01, 10.0, where + "length");
+  RequireRange(flare_exponent, 1.0, 10.0, where + "flare_exponent");
+  RequireFinite(waist_height, where + "waist_height");
+  Require(around >= 8 && around <= 100000, where + "around", "must lie in [8, 100000]");
+  Require(down >= 3 && down <= 100000, where + "down", "must lie in [3, 100000]");
+  RequireRange(sway, 0.0, 1.0, where + "sway");
+  RequireRange(swing, -90.0, 90.0, where + "swing");
+  RequireRange(flare_wobble, 0.0, 0.5, where + "flare_wobble");
+  RequireRange(period, 1e-3, 1e9, where + "period");
+}
+
+void TextureOptions::Check() const {
+  const std::string where = "synth.texture.";
+  Require(width >= 16 && width <= 16384, where + "width", "must lie in [16, 16384]");
+  Require(height >= 16 && height <= 16384, where + "height", "must lie in [16, 16384]");
+  Require(pattern == "mixed" || pattern == "plaid" || pattern == "stripes" || pattern == "print" ||
+              pattern == "noise",
+          where + "pattern",
+          "is '" + pattern + "' but must be one of mixed, plaid, stripes, print, noise");
+  RequireRange(textureless_begin, 0.0, 1.0, where + "textureless_begin");
+  RequireRange(textureless_end, textureless_begin, 1.0, where + "textureless_end");
+  Require(textureless_color.allFinite() && textureless_color.minCoeff() >= 0.0 &&
+              textureless_color.maxCoeff() <= 1.0,
+          where + "textureless_color", "must be RGB in [0, 1]");
+}
+
+void RigOptions::Check() const {
+  const std::string where = "synth.cameras.";
+  Require(count >= 1 && count <= 1000, where + "count", "must lie in [1, 1000]");
+  Require(width >= 16 && width <= 20000, where + "width", "must lie in [16, 20000]");
+  Require(height >= 16 && height <= 20000, where + "height", "must lie in [16, 20000]");
+  RequireRange(focal, 1.0, 1e6, where + "focal");
+  RequireRange(distance, 0.05, 1e4, where + "distance");
+  Require(!heights.empty(), where + "heights", "must list at least one height");
+  for (double h : heights) RequireFinite(h, where + "heights");
+  for (double d : distortion) RequireRange(d, -10.0, 10.0, where + "distortion");
+  RequireRange(rotation_noise, 0.0, 10.0, where + "rotation_noise");
+  RequireRange(translation_noise, 0.0, 1.0, where + "translation_noise");
+  RequireRange(focal_noise, 0.0, 0.5, where + "focal_noise");
+}
+
+RenderOptions SynthOptions::DefaultRenderOptions() {
+  RenderOptions render;
+  render.supersampling = 3;
+  render.shade = true;
+  // Bright enough that the sides turned away from the light keep their texture.
+  render.ambient = 0.5;
+  render.diffuse = 0.6;
+  render.background = Eigen::Vector3d::Constant(0.12);
+  return render;
+}
+
+void SynthOptions::Check() const {
+  const std::string where = "synth.";
+  Require(subject == "skirt" || subject == "mesh", where + "subject",
+          "is '" + subject + "' but must be 'skirt' or 'mesh'");
+  if (subject == "skirt") skirt.Check();
+  if (subject == "mesh") {
+    Require(!mesh_path.empty(), where + "mesh_path", "must name a mesh file or folder");
+    Require(IsPowerOfTwo(truth_refinement), where + "truth_refinement",
+            "must be a power of two for a mesh subject (midpoint subdivision levels)");
+  }
+  Require(num_frames >= 1 && num_frames <= 1000000, where + "num_frames", "must be at least 1");
+  Require(truth_refinement >= 1 && truth_refinement <= 16, where + "truth_refinement",
+          "must lie in [1, 16]");
+  for (size_t i = 0; i < folds.size(); ++i)
+    folds[i].Check(where + "folds[" + std::to_string(i) + "]");
+  Require(single_wavelength == 0.0 || (single_wavelength >= 0.01 && single_wavelength <= 2.0),
+          where + "single_wavelength", "must be 0 (off) or lie in [0.01, 2] metres");
+  Require(fold_ramp_frames >= 0, where + "fold_ramp_frames", "must be >= 0");
+  RequireRange(misalignment, 0.0, 0.1, where + "misalignment");
+  RequireRange(misalignment_wavelength, 0.01, 100.0, where + "misalignment_wavelength");
+  RequireRange(max_displacement, 1e-4, 10.0, where + "max_displacement");
+  texture.Check();
+  cameras.Check();
+  render.Check();
+}
+
+}  // namespace finecap
