@@ -1,24 +1,140 @@
 #include "finecap/config.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include "finecap/error.h"
 
 namespace finecap {
+namespace {
 
-void Config::Check() const { frame_range(); }
+void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
+  schema->AddString("capture.dir", &config->capture.dir,
+                    "Capture folder (cameras, images or videos, meshes; see the README).");
+  schema->AddString("capture.frames", &config->capture.frames,
+                    "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
+                    "\"\" = all.");
+  schema->AddString("output.dir", &config->output.dir,
+                    "Output folder; created if missing; existing files are never overwritten.");
+  schema->AddChoice("output.mesh_format", &config->output.mesh_format,
+                    "Format of refined meshes (PLY is binary).", {"ply", "obj"});
+  schema->AddInt("runtime.threads", &config->runtime.threads,
+                 "Worker threads for parallel stages; 0 = all cores.", 0, 1024);
+}
+
+void AddModelKeys(Config* config, ConfigSchema* schema) {
+  RefineOptions& refine = config->refine;
+  schema->AddInt("model.reference_frame", &config->reference_frame,
+                 "Frame (index in the sorted frame list) whose images colour the surface "
+                 "Gaussians; the paper: the first.",
+                 0);
+  schema->AddInt("model.subdivision_levels", &refine.subdivision_levels,
+                 "Loop subdivision levels applied to the coarse mesh before refinement.", 0, 4);
+  schema->AddDouble("model.sigma_hat", &refine.sigma_hat,
+                    "Standard deviation of every surface Gaussian, metres (paper: 0.007).", 1e-5,
+                    1.0);
+  schema->AddBool("model.bias_compensation", &refine.bias_compensation,
+                  "Add sigma_hat along the normal after solving (the paper's shrink "
+                  "compensation).");
+  schema->AddCustom(
+      "image_gaussians.color_space", "choice", "hsv, normalized_rgb, lab",
+      "Colour space in which colours are averaged and compared (paper: hsv).",
+      [&refine](const YAML::Node& value, const std::string& where) {
+        Require(value.IsScalar(), where, "expected one of: hsv, normalized_rgb, lab");
+        refine.image.color_space = ParseColorSpace(value.Scalar(), where);
+      },
+      [&refine] { return ColorSpaceName(refine.image.color_space); });
+  schema->AddInt("image_gaussians.max_depth", &refine.image.max_depth,
+                 "Quad-tree depth: leaves are min_leaf_size * 2^(max_depth - depth) pixels "
+                 "(paper: 8).",
+                 0, 16);
+  schema->AddInt("image_gaussians.min_leaf_size", &refine.image.min_leaf_size,
+                 "Side of the smallest quad-tree leaf, pixels (its sigma is half of it).", 1, 1024);
+  schema->AddDouble("image_gaussians.split_threshold", &refine.image.split_threshold,
+                    "A square is split while the RMS colour distance of its pixels to their "
+                    "mean exceeds this.",
+                    0.0, 10.0);
+  schema->AddDouble("visibility.depth_tolerance", &refine.visibility.depth_tolerance,
+                    "A vertex more than this behind the rendered input surface is occluded, m.",
+                    0.0, 10.0);
+  schema->AddDouble("visibility.max_view_angle_deg", &refine.visibility.max_view_angle_deg,
+                    "Largest angle between a normal and the direction to a camera that sees it.",
+                    1.0, 90.0);
+  schema->AddDouble("visibility.border_margin", &refine.visibility.border_margin,
+                    "Vertices projecting closer than this to the image border are not used, px.",
+                    0.0, 1000.0);
+}
+
+void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
+  schema->AddChoice("energy.similarity", &energy->similarity,
+                    "paper: the paper's E_sim as printed; surface_color: each surface Gaussian's "
+                    "colour against the image around its projection (peaks at the truth).",
+                    {"paper", "surface_color"});
+  schema->AddChoice("energy.overlap", &energy->overlap,
+                    "Overlap of two Gaussians: the paper's printed form or the exact integral.",
+                    {"printed", "exact"});
+  schema->AddDouble("energy.color_cutoff", &energy->color_cutoff,
+                    "Wendland cut-off D of the colour weight of the paper's E_sim (paper: 0.05).",
+                    1e-6, 10.0);
+  schema->AddDouble("energy.reach_sigmas", &energy->reach_sigmas,
+                    "Pairs of Gaussians are evaluated up to this many combined sigmas apart.", 0.5,
+                    10.0);
+  schema->AddDouble("energy.k_max", &energy->k_max,
+                    "Bound on the displacement along the normal, m.", 1e-5, 1.0);
+  schema->AddDouble("energy.w_reg", &energy->w_reg, "Weight of the regulariser (paper: 1).", 0.0,
+                    1e12);
+  schema->AddInt("energy.reg_rings", &energy->reg_rings,
+                 "Regulariser neighbourhood Delta in edges, also its Wendland cut-off (paper: 2).",
+                 1, 10);
+  schema->AddChoice("energy.reg_unit", &energy->reg_unit,
+                    "Unit of k inside E_reg (the paper's lengths are millimetres).", {"mm", "m"});
+}
+
+void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* schema) {
+  schema->AddChoice("solver.type", &solver->type,
+                    "ceres (least squares, Levenberg-Marquardt), gradient_ascent (the paper's) "
+                    "or lbfgs.",
+                    {"ceres", "gradient_ascent", "lbfgs"});
+  schema->AddInt("solver.max_iterations", &solver->max_iterations,
+                 "Most iterations per frame (the paper's ascent: 150).", 0, 100000);
+  schema->AddDouble("solver.function_tolerance", &solver->function_tolerance,
+                    "Stop when the energy changes by less than this fraction.", 0.0, 1.0);
+  schema->AddChoice("solver.trust_region", &solver->trust_region, "Ceres' trust-region strategy.",
+                    {"levenberg_marquardt", "dogleg"});
+  schema->AddChoice("solver.linear_solver", &solver->linear_solver,
+                    "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on "
+                    "the normal equations, or dense QR (tiny problems only).",
+                    {"sparse_normal_cholesky", "cgnr", "dense_qr"});
+  schema->AddDouble("solver.initial_step", &solver->initial_step,
+                    "Gradient ascent: first step of the steepest k_s, m.", 1e-9, 1.0);
+  schema->AddDouble("solver.step_growth", &solver->step_growth,
+                    "Gradient ascent: step factor growth while a derivative keeps its sign.", 1.0,
+                    10.0);
+  schema->AddDouble("solver.step_shrink", &solver->step_shrink,
+                    "Gradient ascent: step factor shrink when a derivative flips its sign.", 1e-3,
+                    0.999);
+  schema->AddDouble("solver.max_step", &solver->max_step,
+                    "Gradient ascent: largest step of one k_s in one iteration, m.", 1e-9, 1.0);
+  schema->AddBool("refine.keep_input_if_worse", &refine->keep_input_if_worse,
+                  "Write the input surface for a frame whose energy got worse (always flagged).");
+  schema->AddBool("refine.warm_start", &refine->warm_start,
+                  "Start each frame from the previous frame's displacement.");
+}
+
+}  // namespace
+
+void Config::Check() const {
+  frame_range();
+  refine.Check();
+  synth.Check();
+}
 
 ConfigSchema MakeConfigSchema(Config* config) {
   ConfigSchema schema;
-  schema.AddString("capture.dir", &config->capture.dir,
-                   "Capture folder (cameras, images or videos, meshes; see the README).");
-  schema.AddString("capture.frames", &config->capture.frames,
-                   "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
-                   "\"\" = all.");
-  schema.AddString("output.dir", &config->output.dir,
-                   "Output folder; created if missing; existing files are never overwritten.");
-  schema.AddChoice("output.mesh_format", &config->output.mesh_format,
-                   "Format of refined meshes (PLY is binary).", {"ply", "obj"});
-  schema.AddInt("runtime.threads", &config->runtime.threads,
-                "Worker threads for parallel stages; 0 = all cores.", 0, 1024);
+  AddCaptureOutputRuntimeKeys(config, &schema);
+  AddModelKeys(config, &schema);
+  AddEnergyKeys(&config->refine.energy, &schema);
+  AddSolverKeys(&config->refine.solver, &config->refine, &schema);
+  AddSynthKeys(&config->synth, &schema);
   return schema;
 }
 
@@ -29,6 +145,7 @@ Config LoadConfig(const std::string& file, const std::vector<ConfigOverride>& ov
   for (const ConfigOverride& override_value : overrides) {
     schema.Set(override_value.key, override_value.value, override_value.source);
   }
+  config.refine.solver.num_threads = config.runtime.threads;
   try {
     config.Check();
   } catch (const Error& error) {

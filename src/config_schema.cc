@@ -151,6 +151,14 @@ void ConfigSchema::AddDoubleList(const std::string& path, std::vector<double>* f
           [=] { return DoubleListText(*field); }});
 }
 
+void ConfigSchema::AddCustom(
+    const std::string& path, const std::string& type, const std::string& range,
+    const std::string& doc,
+    std::function<void(const YAML::Node& value, const std::string& where)> assign,
+    std::function<std::string()> current_text) {
+  AddKey({path, type, range, doc, "", std::move(assign), std::move(current_text)});
+}
+
 void ConfigSchema::ReadFile(const std::string& file) {
   YAML::Node root;
   try {

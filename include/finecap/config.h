@@ -10,6 +10,8 @@
 
 #include "finecap/config_schema.h"
 #include "finecap/frame_range.h"
+#include "finecap/refine.h"
+#include "finecap/synth.h"
 
 namespace finecap {
 
@@ -39,6 +41,14 @@ struct Config {
   CaptureConfig capture;
   OutputConfig output;
   RuntimeConfig runtime;
+  // Index, in the capture's sorted frame list, of the frame whose images colour the surface
+  // Gaussians. Default 0 (the paper: "typically the first frame").
+  int reference_frame = 0;
+  // Everything the refinement of a frame uses (sections model, image_gaussians, visibility,
+  // energy, solver, refine).
+  RefineOptions refine;
+  // `finecap synth` (section synth).
+  SynthOptions synth;
 
   // Cross-key checks that a single key's range cannot express. Throws Error naming the keys.
   void Check() const;
@@ -47,6 +57,9 @@ struct Config {
 
 // Binds every config key to a field of `*config`, which must outlive the schema.
 ConfigSchema MakeConfigSchema(Config* config);
+
+// The keys of section `synth` (config_synth.cc), bound to `*options`.
+void AddSynthKeys(SynthOptions* options, ConfigSchema* schema);
 
 // A key=value override from the command line; `source` names it in errors (e.g. "--set").
 struct ConfigOverride {

@@ -37,6 +37,13 @@ class ConfigSchema {
                      double min = std::numeric_limits<double>::lowest(),
                      double max = std::numeric_limits<double>::max());
 
+  // A key of any other type: `assign` parses and checks a YAML value and writes the field,
+  // throwing Error(where, problem) on failure; `current_text` prints the field as YAML.
+  void AddCustom(const std::string& path, const std::string& type, const std::string& range,
+                 const std::string& doc,
+                 std::function<void(const YAML::Node& value, const std::string& where)> assign,
+                 std::function<std::string()> current_text);
+
   // Reads a YAML file into the bound fields. Keys absent from the file keep their values.
   void ReadFile(const std::string& file);
   // Reads an already parsed document; `file` names it in errors.

@@ -1,0 +1,115 @@
+// Per-frame refinement, the product's main job, independent of files and flags: subdivide the
+// coarse mesh, find what each camera sees, build the image Gaussians, set up the energy, solve
+// for the displacement k of every refined vertex along its normal, and apply it.
+//
+// Data flows one way: the caller reads a frame (coarse mesh, images) and writes the result.
+// What stays fixed over a sequence (topology, subdivision stencil, neighbourhoods, the refined
+// vertices, the reference colours) lives in SequenceModel and is computed once.
+#ifndef FINECAP_REFINE_H_
+#define FINECAP_REFINE_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "finecap/camera.h"
+#include "finecap/energy_options.h"
+#include "finecap/image_gaussians.h"
+#include "finecap/mesh.h"
+#include "finecap/neighbourhood.h"
+#include "finecap/solver.h"
+#include "finecap/subdivision.h"
+#include "finecap/surface_gaussians.h"
+#include "finecap/visibility.h"
+
+namespace finecap {
+
+struct RefineOptions {
+  // Loop subdivision levels applied to the coarse mesh before refinement (the paper subdivided
+  // its 1.5k-2.5k-vertex meshes to 6k-10k vertices: 1 level). Default 1.
+  int subdivision_levels = 1;
+  // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007.
+  double sigma_hat = 0.007;
+  // After solving, add sigma_hat along the normal to every refined vertex, compensating the
+  // slight shrink the Gaussians' extent causes (the paper's section 6). Default true.
+  bool bias_compensation = true;
+  // When the solver ends with a lower energy than it started from (the run's own measure says
+  // the frame got worse), write the input surface for that frame instead. The stats record flags
+  // such frames either way. Default false.
+  bool keep_input_if_worse = false;
+  // Start each frame from the previous frame's k instead of from zero. Default false.
+  bool warm_start = false;
+
+  ImageGaussianOptions image;
+  VisibilityOptions visibility;
+  EnergyOptions energy;
+  SolverOptions solver;
+
+  void Check() const;
+};
+
+// One frame's input: the coarse mesh and, per camera, the pinhole camera and its undistorted
+// 8-bit BGR image.
+struct FrameInput {
+  Mesh coarse;
+  std::vector<Camera> cameras;
+  std::vector<cv::Mat> images;
+};
+
+// The parts of the model that stay fixed over a sequence.
+class SequenceModel {
+ public:
+  // `first_coarse` fixes the topology; `coarse_mask` lists the coarse vertex ids to refine
+  // (empty: all). Throws Error naming `where` when the mesh cannot be subdivided.
+  SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
+                const RefineOptions& options, const std::string& where);
+
+  // The subdivided mesh of a frame and its area-weighted unit normals.
+  Mesh Subdivide(const Mesh& coarse) const;
+  int num_fine_vertices() const { return stencil_.num_fine_vertices(); }
+  // Fine vertex ids to refine: the subdivided mask (all when there is none). Those that no camera
+  // saw in the reference frame get no surface Gaussian.
+  const std::vector<int>& refined_vertices() const { return refined_vertices_; }
+  const VertexNeighbourhoods& neighbourhoods() const { return neighbourhoods_; }
+
+ private:
+  SubdivisionStencil stencil_;
+  std::vector<int> refined_vertices_;
+  VertexNeighbourhoods neighbourhoods_;
+};
+
+// For each camera, which fine vertices of `mesh` (with `normals`) it sees.
+std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
+                                                               const Eigen::Matrix3Xd& normals,
+                                                               const std::vector<Camera>& cameras,
+                                                               const VisibilityOptions& options);
+
+// The colours of the fine vertices, from the reference frame's images.
+ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
+                                      const RefineOptions& options);
+
+struct FrameResult {
+  Mesh refined;              // The fine mesh with the displacement applied.
+  Eigen::Matrix3Xd normals;  // Unit normals of `refined`.
+  Eigen::VectorXd k;         // Per fine vertex, metres (bias included); NaN where not refined.
+  Eigen::VectorXd k_solved;  // Per surface Gaussian, as solved (for warm starts).
+  SolverSummary summary;
+  bool worse = false;       // The solve ended with a lower energy than it started from.
+  bool kept_input = false;  // The input surface was written instead (keep_input_if_worse).
+  int num_surface_gaussians = 0;
+  long num_image_gaussians = 0;
+  long num_pairs = 0;
+  double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
+  double seconds_total = 0.0;        // The whole frame.
+};
+
+// Refines one frame. `warm_start` (may be null) is a previous frame's k_solved.
+FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
+                        const FrameInput& input, const RefineOptions& options,
+                        const Eigen::VectorXd* warm_start = nullptr);
+
+}  // namespace finecap
+
+#endif  // FINECAP_REFINE_H_
