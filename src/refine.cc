@@ -43,10 +43,16 @@ void RefineOptions::Check() const {
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
-    : stencil_(BuildLoopSubdivision(first_coarse, options.subdivision_levels, where)) {
-  refined_vertices_ = FineMaskIds(stencil_, coarse_mask, first_coarse.num_vertices());
+    : stencil_(BuildLoopSubdivision(first_coarse, options.subdivision_levels, where)),
+      num_coarse_vertices_(first_coarse.num_vertices()) {
+  refined_vertices_ = FineMaskIds(stencil_, coarse_mask, num_coarse_vertices_);
   const Mesh fine = ApplySubdivision(stencil_, first_coarse.vertices);
   neighbourhoods_ = BuildVertexNeighbourhoods(fine, options.energy.reg_rings, where);
+}
+
+std::vector<int> SequenceModel::SubdivideIds(const std::vector<int>& coarse_ids) const {
+  if (coarse_ids.empty()) return {};
+  return FineMaskIds(stencil_, coarse_ids, num_coarse_vertices_);
 }
 
 Mesh SequenceModel::Subdivide(const Mesh& coarse) const {
@@ -74,33 +80,44 @@ ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInp
                                 visible, options.image.color_space, options.sigma_hat);
 }
 
+PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PreparedFrame frame;
+  frame.fine = model.Subdivide(input.coarse);
+  frame.normals = ComputeVertexNormals(frame.fine);
+  const auto visible =
+      ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
+  std::vector<std::string> names;
+  for (const Camera& camera : input.cameras) names.push_back(camera.name);
+  frame.images = BuildFrameImageGaussians(input.images, {}, options.image, names);
+
+  SurfaceGaussians surface =
+      MakeSurfaceGaussians(frame.fine.vertices, frame.normals, model.refined_vertices(), colors);
+  std::vector<CameraInput> cameras(input.cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    cameras[c].camera = input.cameras[c];
+    cameras[c].image = &frame.images[c];
+    for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
+    frame.num_image_gaussians += frame.images[c].size();
+  }
+  frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
+                                               options.energy);
+  frame.seconds = SecondsSince(start);
+  return frame;
+}
+
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
                         const Eigen::VectorXd* warm_start) {
   const auto start = std::chrono::steady_clock::now();
+  PreparedFrame frame = PrepareFrame(model, colors, input, options);
+  FrameEnergy& energy = *frame.energy;
   FrameResult result;
-  const Mesh fine = model.Subdivide(input.coarse);
-  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible = ComputeFrameVisibility(fine, normals, input.cameras, options.visibility);
-
-  std::vector<std::string> names;
-  for (const Camera& camera : input.cameras) names.push_back(camera.name);
-  const std::vector<ImageGaussians> images =
-      BuildFrameImageGaussians(input.images, {}, options.image, names);
-
-  SurfaceGaussians surface =
-      MakeSurfaceGaussians(fine.vertices, normals, model.refined_vertices(), colors);
-  std::vector<CameraInput> cameras(input.cameras.size());
-  for (size_t c = 0; c < cameras.size(); ++c) {
-    cameras[c].camera = input.cameras[c];
-    cameras[c].image = &images[c];
-    for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
-    result.num_image_gaussians += images[c].size();
-  }
-  result.num_surface_gaussians = surface.size();
-  FrameEnergy energy(std::move(surface), cameras, model.neighbourhoods(), options.energy);
+  result.num_surface_gaussians = energy.num_parameters();
+  result.num_image_gaussians = frame.num_image_gaussians;
   result.num_pairs = energy.num_pairs();
-  result.seconds_preparation = SecondsSince(start);
+  result.seconds_preparation = frame.seconds;
 
   Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
   if (warm_start != nullptr && warm_start->size() == k.size()) k = *warm_start;
@@ -110,13 +127,13 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.kept_input = result.worse && options.keep_input_if_worse;
 
   const double bias = options.bias_compensation ? options.sigma_hat : 0.0;
-  result.refined = fine;
-  result.k = Eigen::VectorXd::Constant(fine.num_vertices(), std::nan(""));
+  result.refined = frame.fine;
+  result.k = Eigen::VectorXd::Constant(frame.fine.num_vertices(), std::nan(""));
   const std::vector<int>& ids = energy.surface().vertex_ids;
   for (size_t s = 0; s < ids.size(); ++s) {
     const double displacement = result.kept_input ? 0.0 : k[s] + bias;
     result.k[ids[s]] = displacement;
-    result.refined.vertices.col(ids[s]) += displacement * normals.col(ids[s]);
+    result.refined.vertices.col(ids[s]) += displacement * frame.normals.col(ids[s]);
   }
   result.normals = ComputeVertexNormals(result.refined);
   result.seconds_total = SecondsSince(start);

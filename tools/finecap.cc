@@ -40,6 +40,9 @@ struct Subcommand {
 
 const std::vector<Subcommand>& Subcommands() {
   static const std::vector<Subcommand> kSubcommands = {
+      {"synth", "Generate a synthetic capture with ground truth (cameras, images, meshes, gt/).",
+       "finecap synth --config configs/synth_demo.yaml --out data/demo", &RunSynth,
+       {"config", "out", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
        "finecap refine --config configs/demo.yaml [--frames A:B] [--capture DIR] [--out DIR]",

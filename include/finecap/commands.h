@@ -11,6 +11,9 @@ namespace finecap {
 // Loads the capture, refines the configured frames and writes the results to output.dir.
 int RunRefine(const Config& config);
 
+// Generates a synthetic capture with ground truth (section synth) into output.dir.
+int RunSynth(const Config& config);
+
 }  // namespace finecap
 
 #endif  // FINECAP_COMMANDS_H_

@@ -8,6 +8,7 @@
 #ifndef FINECAP_REFINE_H_
 #define FINECAP_REFINE_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 
 #include "finecap/camera.h"
 #include "finecap/energy_options.h"
+#include "finecap/frame_energy.h"
 #include "finecap/image_gaussians.h"
 #include "finecap/mesh.h"
 #include "finecap/neighbourhood.h"
@@ -73,9 +75,13 @@ class SequenceModel {
   // saw in the reference frame get no surface Gaussian.
   const std::vector<int>& refined_vertices() const { return refined_vertices_; }
   const VertexNeighbourhoods& neighbourhoods() const { return neighbourhoods_; }
+  // The fine vertices that subdivision makes from coarse vertices `coarse_ids` (an edge vertex
+  // belongs when both its ends do). Empty in, empty out.
+  std::vector<int> SubdivideIds(const std::vector<int>& coarse_ids) const;
 
  private:
   SubdivisionStencil stencil_;
+  int num_coarse_vertices_ = 0;
   std::vector<int> refined_vertices_;
   VertexNeighbourhoods neighbourhoods_;
 };
@@ -89,6 +95,20 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
 // The colours of the fine vertices, from the reference frame's images.
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
                                       const RefineOptions& options);
+
+// A frame made ready to solve: its fine mesh, the image Gaussians and the energy over them.
+struct PreparedFrame {
+  Mesh fine;                            // The subdivided input mesh.
+  Eigen::Matrix3Xd normals;             // Its unit normals, along which k displaces.
+  std::vector<ImageGaussians> images;   // One per camera; the energy refers to them.
+  std::unique_ptr<FrameEnergy> energy;  // Over the surface Gaussians of the refined vertices.
+  long num_image_gaussians = 0;
+  double seconds = 0.0;
+};
+
+// Subdivision, visibility, image Gaussians, surface Gaussians and pair lists of one frame.
+PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options);
 
 struct FrameResult {
   Mesh refined;              // The fine mesh with the displacement applied.

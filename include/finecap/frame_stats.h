@@ -1,0 +1,47 @@
+// The statistics record of one refined frame: one JSON object per frame, one line each in the
+// output folder's stats.jsonl.
+#ifndef FINECAP_FRAME_STATS_H_
+#define FINECAP_FRAME_STATS_H_
+
+#include <string>
+
+#include "finecap/refine.h"
+
+namespace finecap {
+
+struct FrameStats {
+  std::string frame;       // The frame's name.
+  std::string solver;      // solver.type.
+  std::string similarity;  // energy.similarity.
+  double energy_start = 0.0;
+  double energy_end = 0.0;
+  double ls_cost_start = 0.0;
+  double ls_cost_end = 0.0;
+  int iterations = 0;
+  int evaluations = 0;
+  std::string termination;
+  double seconds = 0.0;                // The whole frame, reading and writing included.
+  double seconds_preparation = 0.0;    // Subdivision, visibility, image Gaussians, pairs.
+  double seconds_solve = 0.0;
+  double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
+  double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.
+  int surface_gaussians = 0;
+  long image_gaussians = 0;
+  long pairs = 0;
+  bool worse = false;       // The run's own energy says the frame got worse.
+  bool kept_input = false;  // And the input surface was written instead.
+  // Against ground truth, when the capture has it (NaN otherwise): RMS of k - k_true over the
+  // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
+  double rms_coarse_mm = 0.0;
+  double rms_refined_mm = 0.0;
+};
+
+FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
+                          const FrameResult& result);
+
+// One line of JSON (no newline). Non-finite numbers are written as null.
+std::string ToJson(const FrameStats& stats);
+
+}  // namespace finecap
+
+#endif  // FINECAP_FRAME_STATS_H_

@@ -1,0 +1,100 @@
+#include "commands/command_util.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "finecap/error.h"
+#include "finecap/ground_truth.h"
+
+namespace finecap {
+namespace internal {
+
+namespace fs = std::filesystem;
+
+Capture OpenConfiguredCapture(const Config& config) {
+  Require(!config.capture.dir.empty(), "capture.dir",
+          "no capture folder given (set capture.dir or pass --capture DIR)");
+  return Capture::Open(config.capture.dir);
+}
+
+FrameRange ConfiguredFrames(const Config& config, const Capture& capture) {
+  const FrameRange range = config.frame_range().ClippedTo(capture.num_frames());
+  Require(range.size() > 0, "capture.frames",
+          "'" + config.capture.frames + "' selects no frame of " + capture.directory() +
+              ", which has " + std::to_string(capture.num_frames()));
+  return range;
+}
+
+std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
+  Require(!config.output.dir.empty(), "output.dir",
+          "no output folder given (set output.dir or pass --out DIR)");
+  const fs::path out = fs::weakly_canonical(config.output.dir);
+  const fs::path in = fs::weakly_canonical(capture.directory());
+  const auto [mismatch, unused] = std::mismatch(in.begin(), in.end(), out.begin(), out.end());
+  Require(mismatch != in.end(), config.output.dir,
+          "the output folder may not be the capture folder or lie inside it");
+  std::error_code error;
+  fs::create_directories(out, error);
+  Require(!error && fs::is_directory(out), config.output.dir,
+          "cannot create the output folder: " + error.message());
+  return out.string();
+}
+
+FrameInput ReadFrameInput(Capture* capture, int frame) {
+  FrameInput input;
+  input.coarse = capture->ReadCoarseMesh(frame);
+  input.cameras = capture->cameras();
+  for (int c = 0; c < capture->num_cameras(); ++c) {
+    input.images.push_back(capture->ReadImage(c, frame));
+  }
+  return input;
+}
+
+ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
+                                             Capture* capture, const std::string& path) {
+  if (fs::exists(path)) return ReadReferenceColors(path, model.num_fine_vertices());
+  Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
+          "frame " + std::to_string(config.reference_frame) + " does not exist in " +
+              capture->directory());
+  const FrameInput reference = ReadFrameInput(capture, config.reference_frame);
+  const ReferenceColors colors = ComputeSequenceColors(model, reference, config.refine);
+  WriteReferenceColors(path, colors);
+  return colors;
+}
+
+Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
+                                     const Mesh& coarse, int frame) {
+  if (!capture.HasTrueSurface(frame)) return {};
+  const Mesh fine = model.Subdivide(coarse);
+  return TrueDisplacementAlongNormals(fine.vertices, ComputeVertexNormals(fine),
+                                      capture.ReadTrueSurface(frame), 0.1);
+}
+
+Progress::Progress(int total)
+    : total_(total), terminal_(isatty(fileno(stderr))), last_(std::chrono::steady_clock::now()) {}
+
+void Progress::FrameDone(const std::string& name, bool skipped, const std::string& detail) {
+  const auto now = std::chrono::steady_clock::now();
+  ++done_;
+  if (!skipped) {
+    seconds_ += std::chrono::duration<double>(now - last_).count();
+    ++timed_;
+  }
+  last_ = now;
+  const double per_frame = timed_ > 0 ? seconds_ / timed_ : 0.0;
+  char line[256];
+  std::snprintf(line, sizeof(line), "frame %d/%d (%s) %s| %.1f s/frame, %.0f s left", done_,
+                total_, name.c_str(), skipped ? "already done " : "", per_frame,
+                per_frame * (total_ - done_));
+  if (terminal_) {
+    std::cerr << "\r\033[K" << line << (done_ == total_ ? "\n" : "") << std::flush;
+  } else {
+    std::cerr << line << (detail.empty() ? "" : " | " + detail) << "\n";
+  }
+}
+
+}  // namespace internal
+}  // namespace finecap

@@ -1,0 +1,58 @@
+// What the subcommands share: opening the input capture, preparing the output folder, reading
+// one frame, the reference colours, and progress output.
+#ifndef FINECAP_SRC_COMMANDS_COMMAND_UTIL_H_
+#define FINECAP_SRC_COMMANDS_COMMAND_UTIL_H_
+
+#include <chrono>
+#include <string>
+
+#include "finecap/capture.h"
+#include "finecap/config.h"
+#include "finecap/refine.h"
+
+namespace finecap {
+namespace internal {
+
+// Opens config.capture.dir; an Error names the key when it is empty.
+Capture OpenConfiguredCapture(const Config& config);
+
+// The configured frames of `capture`; an Error when the range holds none of its frames.
+FrameRange ConfiguredFrames(const Config& config, const Capture& capture);
+
+// Creates config.output.dir (and its parents) unless it exists; refuses the capture folder
+// itself or a folder inside it, so that nothing a user gave is ever written over.
+std::string PrepareOutputFolder(const Config& config, const Capture& capture);
+
+// The coarse mesh, cameras and undistorted images of one frame.
+FrameInput ReadFrameInput(Capture* capture, int frame);
+
+// The reference colours saved in `path`, or, when there is no such file, those of the
+// configured reference frame, computed and saved there.
+ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
+                                             Capture* capture, const std::string& path);
+
+// The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
+// vector when the capture has no true surface for the frame.
+Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
+                                     const Mesh& coarse, int frame);
+
+// Progress of a run over frames: a line rewritten in place on a terminal, plain lines otherwise.
+class Progress {
+ public:
+  explicit Progress(int total);
+  // Call after each frame; `skipped` frames do not count towards the time per frame.
+  void FrameDone(const std::string& name, bool skipped, const std::string& detail);
+
+ private:
+  int total_;
+  int done_ = 0;
+  int timed_ = 0;
+  double seconds_ = 0.0;
+  bool terminal_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+}  // namespace internal
+}  // namespace finecap
+
+#endif  // FINECAP_SRC_COMMANDS_COMMAND_UTIL_H_

@@ -1,0 +1,88 @@
+#include "finecap/frame_stats.h"
+
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+namespace finecap {
+namespace {
+
+std::string JsonString(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      quoted += '\\';
+      quoted += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      quoted += escaped;
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "\"";
+}
+
+std::string JsonNumber(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream text;
+  text << std::setprecision(10) << value;
+  return text.str();
+}
+
+}  // namespace
+
+FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
+                          const FrameResult& result) {
+  FrameStats stats;
+  const SolverSummary& summary = result.summary;
+  stats.frame = frame;
+  stats.solver = options.solver.type;
+  stats.similarity = options.energy.similarity;
+  stats.energy_start = summary.energy_start;
+  stats.energy_end = summary.energy_end;
+  stats.ls_cost_start = summary.ls_cost_start;
+  stats.ls_cost_end = summary.ls_cost_end;
+  stats.iterations = summary.iterations;
+  stats.evaluations = summary.evaluations;
+  stats.termination = summary.termination;
+  stats.seconds = result.seconds_total;
+  stats.seconds_preparation = result.seconds_preparation;
+  stats.seconds_solve = summary.seconds;
+  stats.seconds_evaluation = summary.seconds_evaluation;
+  stats.seconds_linear_solver = summary.seconds_linear_solver;
+  stats.surface_gaussians = result.num_surface_gaussians;
+  stats.image_gaussians = result.num_image_gaussians;
+  stats.pairs = result.num_pairs;
+  stats.worse = result.worse;
+  stats.kept_input = result.kept_input;
+  stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
+  return stats;
+}
+
+std::string ToJson(const FrameStats& s) {
+  std::ostringstream json;
+  json << "{\"frame\": " << JsonString(s.frame) << ", \"solver\": " << JsonString(s.solver)
+       << ", \"similarity\": " << JsonString(s.similarity)
+       << ", \"energy_start\": " << JsonNumber(s.energy_start)
+       << ", \"energy_end\": " << JsonNumber(s.energy_end)
+       << ", \"ls_cost_start\": " << JsonNumber(s.ls_cost_start)
+       << ", \"ls_cost_end\": " << JsonNumber(s.ls_cost_end) << ", \"iterations\": " << s.iterations
+       << ", \"evaluations\": " << s.evaluations
+       << ", \"termination\": " << JsonString(s.termination)
+       << ", \"seconds\": " << JsonNumber(s.seconds)
+       << ", \"seconds_preparation\": " << JsonNumber(s.seconds_preparation)
+       << ", \"seconds_solve\": " << JsonNumber(s.seconds_solve)
+       << ", \"seconds_evaluation\": " << JsonNumber(s.seconds_evaluation)
+       << ", \"seconds_linear_solver\": " << JsonNumber(s.seconds_linear_solver)
+       << ", \"surface_gaussians\": " << s.surface_gaussians
+       << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
+       << ", \"worse\": " << (s.worse ? "true" : "false")
+       << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
+       << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
+       << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm) << "}";
+  return json.str();
+}
+
+}  // namespace finecap

@@ -1,4 +1,0 @@
-namespace finecap {
-struct Config;
-int RunRefine(const Config&) { return 0; }
-}  // namespace finecap
