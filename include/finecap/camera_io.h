@@ -2,7 +2,8 @@
 //
 // Every reader returns cameras in finecap's convention (see camera.h): metres, x_cam = R*X + t,
 // OpenCV axes, centre of the top-left pixel at (0, 0), OpenCV distortion (k1, k2, p1, p2, k3).
-// Every reader validates each camera and throws Error naming the file and the problem.
+// Every reader validates each camera and throws Error naming the file and the problem (and, where
+// it applies, the camera and the key).
 #ifndef FINECAP_CAMERA_IO_H_
 #define FINECAP_CAMERA_IO_H_
 
@@ -13,21 +14,46 @@
 
 namespace finecap {
 
-// finecap's own cameras.yaml (the file states the convention in a comment at its top).
+// finecap's own cameras.yaml, cameras in file order. Its schema (every written file repeats it in
+// a comment at its top):
+//
+//   cameras:
+//     - name: cam0
+//       width: 1004                        # pixels
+//       height: 1004
+//       K: [fx, s, cx, 0, fy, cy, 0, 0, 1] # row-major 3x3, pixels
+//       R: [r00, r01, ..., r22]            # row-major world-to-camera rotation
+//       t: [tx, ty, tz]                    # metres
+//       distortion: [k1, k2, p1, p2, k3]   # optional, OpenCV order, default zeros
+//
+// Unknown keys, values of the wrong type or length, duplicate names and cameras that fail
+// Camera::Validate are refused. The writer validates every camera first, prints doubles with 17
+// significant digits (reading the file back gives the same bits) and writes atomically.
 std::vector<Camera> ReadCamerasYaml(const std::string& path);
 void WriteCamerasYaml(const std::vector<Camera>& cameras, const std::string& path);
 
 // A COLMAP text model: `folder`/cameras.txt and `folder`/images.txt. Supports the PINHOLE,
 // SIMPLE_PINHOLE, SIMPLE_RADIAL, RADIAL and OPENCV camera models; COLMAP's pixel centres sit at
-// +0.5, which the reader converts. Camera names are the image names without their extension.
+// +0.5 (the top-left pixel's centre is (0.5, 0.5)), which the reader subtracts from the principal
+// point. The pose of an image is COLMAP's world-to-camera quaternion QW QX QY QZ and translation.
+// A camera is named after its image: the image's folder when the NAME has one (`cam03/000000.jpg`
+// -> `cam03`), else the file stem (`cam03.jpg` -> `cam03`). When several images share a camera
+// name (several frames of one fixed camera), the one with the smallest IMAGE_ID gives the pose.
+// Cameras are returned in order of their first IMAGE_ID.
 std::vector<Camera> ReadColmapTextModel(const std::string& folder);
 
-// The OpenCV FileStorage pair intri.yml / extri.yml of ZJU-MoCap and EasyMocap: K_<cam>,
-// dist_<cam>, R_<cam> (a rotation vector, or Rot_<cam> as a matrix), T_<cam>.
+// The OpenCV FileStorage pair intri.yml / extri.yml of ZJU-MoCap and EasyMocap: the `names` list
+// (in intri.yml), K_<cam>, dist_<cam> (1xN or Nx1 with N <= 5, missing coefficients are zero),
+// R_<cam> (a Rodrigues rotation vector) or Rot_<cam> (a 3x3 matrix, preferred when both are
+// present), T_<cam> (metres). The image size comes from H_<cam> / W_<cam> in intri.yml when
+// present; otherwise width and height are 0, meaning "take it from the camera's first image":
+// everything but the size is validated here, and the capture loader validates the camera again
+// once it has filled the size in.
 std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::string& extri_path);
 
 // The rig of a capture folder: cameras.yaml if present, else intri.yml + extri.yml, else a COLMAP
-// text model in `capture_dir`/sparse (or `capture_dir` itself). Throws Error if none is found.
+// text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or `capture_dir` itself (the first
+// holding a cameras.txt). Throws Error naming the folder if none is found.
 std::vector<Camera> ReadRig(const std::string& capture_dir);
 
 }  // namespace finecap

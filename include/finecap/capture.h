@@ -1,0 +1,110 @@
+// A capture folder: the calibrated rig, the synchronized images of each camera, the coarse mesh
+// of each frame and, for synthetic captures, the ground truth.
+//
+//   capture/
+//     cameras.yaml (or intri.yml + extri.yml, or a COLMAP text model; see camera_io.h)
+//     images/<camera>/<frame>.png|.jpg|.jpeg   or   videos/<camera>.<ext>
+//     meshes/<frame>.<ply|obj|off|...>          coarse mesh per frame, one topology
+//     mask.txt                                  optional: vertex ids to refine (vertex_mask.h)
+//     gt/<frame>.ply                            optional: the true (fine) surface of that frame
+//     gt/<frame>_k.txt                          optional: per coarse vertex, the true displacement
+//                                               along its coarse normal, metres, one a line ("nan"
+//                                               where unknown)
+//     gt/textureless.txt                        optional: coarse vertex ids of the textureless
+//     region
+//
+// Frames are named by the mesh file stems (hidden files, e.g. unfinished writes, are ignored),
+// sorted numerically when every stem is a number (`2` before `10`), else as text.
+#ifndef FINECAP_CAPTURE_H_
+#define FINECAP_CAPTURE_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "finecap/camera.h"
+#include "finecap/frame_source.h"
+#include "finecap/mesh.h"
+
+namespace finecap {
+
+class Capture {
+ public:
+  // Opens and checks `dir` cheaply, so that a broken capture fails before any work: the folder
+  // exists; the rig reads and every camera is valid (an intri/extri rig without image sizes gets
+  // them from each camera's first image); there is at least one mesh and the first one is a valid
+  // mesh; every camera has images/<camera>/ or videos/<camera>.*; the first image of every camera
+  // decodes and has the camera's size; mask.txt and gt/textureless.txt, when present, hold valid
+  // ids. Later frames are checked when read. Throws Error naming the file and the problem.
+  static Capture Open(const std::string& dir);
+
+  Capture(Capture&&) = default;
+  Capture& operator=(Capture&&) = default;
+
+  const std::string& directory() const { return directory_; }
+
+  // The cameras of the images ReadImage returns: the rig's, with distortion zero (images are
+  // undistorted on load, same K).
+  const std::vector<Camera>& cameras() const { return cameras_; }
+  int num_cameras() const { return static_cast<int>(cameras_.size()); }
+
+  int num_frames() const { return static_cast<int>(frame_names_.size()); }
+  const std::string& frame_name(int frame) const;
+  const std::vector<std::string>& frame_names() const { return frame_names_; }
+
+  // The coarse mesh of `frame`, validated and with the topology of frame 0. Throws Error naming
+  // the file otherwise.
+  Mesh ReadCoarseMesh(int frame) const;
+  int num_coarse_vertices() const { return first_mesh_.num_vertices(); }
+
+  // The undistorted image of camera `camera_index` at `frame`: CV_8UC3 BGR of the camera's size.
+  // Not const: a camera's video decoder moves along. Reading different cameras from different
+  // threads is safe; reading one camera from two threads is not.
+  cv::Mat ReadImage(int camera_index, int frame);
+
+  // The sorted vertex ids of mask.txt; empty when the capture has no mask (refine every vertex).
+  const std::vector<int>& vertex_mask() const { return vertex_mask_; }
+  bool has_vertex_mask() const { return has_vertex_mask_; }
+
+  // True when the capture has a gt/ folder. Which files it holds is per frame:
+  bool has_ground_truth() const { return has_ground_truth_; }
+  bool HasTrueSurface(int frame) const;
+  bool HasTrueDisplacement(int frame) const;
+  // gt/<frame>.ply: the true surface (any topology). Throws Error naming the file when absent.
+  Mesh ReadTrueSurface(int frame) const;
+  // gt/<frame>_k.txt: one true displacement (metres) per coarse vertex, NaN where unknown.
+  // Throws Error naming the file (and line) when absent, malformed, infinite or of the wrong
+  // length.
+  Eigen::VectorXd ReadTrueDisplacement(int frame) const;
+  // gt/textureless.txt, sorted; empty when absent.
+  const std::vector<int>& textureless_vertices() const { return textureless_vertices_; }
+
+ private:
+  Capture() = default;
+
+  void ReadCameras();
+  void FindFrames();
+  void OpenFrameSources();
+  void ReadOptionalFiles();
+  void RequireFrame(int frame) const;
+  std::string GroundTruthPath(int frame, const std::string& suffix) const;
+
+  std::string directory_;
+  std::vector<Camera> rig_;      // As calibrated, distortion included.
+  std::vector<Camera> cameras_;  // rig_ undistorted.
+  std::vector<std::string> frame_names_;
+  std::vector<std::string> mesh_paths_;
+  Mesh first_mesh_;
+  std::vector<std::unique_ptr<FrameSource>> sources_;
+  std::vector<int> vertex_mask_;
+  bool has_vertex_mask_ = false;
+  bool has_ground_truth_ = false;
+  std::vector<int> textureless_vertices_;
+};
+
+}  // namespace finecap
+
+#endif  // FINECAP_CAPTURE_H_

@@ -1,0 +1,59 @@
+// The images of one camera, delivered one frame at a time and undistorted on load.
+//
+// A FrameSource holds no more than one frame (and, for a lens with distortion, the camera's two
+// undistortion maps) whatever the sequence's length. Every image it returns is CV_8UC3 BGR, of the
+// camera's size, and undistorted: it is the image of `camera.Undistorted()` (same K, distortion
+// zero), resampled bilinearly with maps computed once by cv::initUndistortRectifyMap.
+#ifndef FINECAP_FRAME_SOURCE_H_
+#define FINECAP_FRAME_SOURCE_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "finecap/camera.h"
+
+namespace finecap {
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+
+  // The undistorted image of frame `frame`, 0 <= frame < num_frames(). Throws Error naming the
+  // file when the image is missing, empty (0 bytes), truncated or undecodable, when its size is
+  // not the camera's, or when a video ends before `frame`.
+  virtual cv::Mat Read(int frame) = 0;
+
+  virtual int num_frames() const = 0;
+};
+
+// Frame i is the image `folder`/<frame_names[i]>.png (or .jpg, .jpeg; extension case ignored).
+// When no file has exactly that stem and the frame name is a number, an image whose stem is the
+// same number (`12.png` for frame `000012`) is taken. The folder is listed once, here; a frame
+// without an image is reported when it is read.
+std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
+                                                   const std::vector<std::string>& frame_names,
+                                                   const Camera& camera);
+
+// Frame i is the i-th frame of the video at `path` (anything cv::VideoCapture opens), for
+// `num_frames` frames. Frames asked in increasing order are decoded sequentially (skipping
+// forward up to 32 frames by decoding them); any other jump seeks with CAP_PROP_POS_FRAMES.
+std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,
+                                             const Camera& camera);
+
+// MakeImageFolderSource when `path` is a folder, else MakeVideoSource with frame_names.size().
+// The camera must have a positive size (Camera::Validate); throws Error naming `path` otherwise
+// or when it does not exist.
+std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path,
+                                             const std::vector<std::string>& frame_names,
+                                             const Camera& camera);
+
+// The size of frame 0 as stored at `path` (a folder or a video, as for OpenFrameSource), for rigs
+// that do not state their image size. Throws Error naming the file when it cannot be read.
+cv::Size ReadFirstFrameSize(const std::string& path, const std::vector<std::string>& frame_names);
+
+}  // namespace finecap
+
+#endif  // FINECAP_FRAME_SOURCE_H_

@@ -1,0 +1,79 @@
+#include "io_util.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "finecap/error.h"
+
+namespace finecap {
+namespace internal {
+
+void RequireFile(const std::string& path) {
+  std::error_code error;
+  Require(std::filesystem::exists(path, error), path, "file not found");
+  Require(std::filesystem::is_regular_file(path, error), path, "is not a regular file");
+}
+
+std::string ReadWholeFile(const std::string& path) {
+  RequireFile(path);
+  std::ifstream stream(path, std::ios::binary);
+  Require(static_cast<bool>(stream), path, "cannot open the file for reading");
+  std::ostringstream contents;
+  contents << stream.rdbuf();
+  Require(!stream.bad(), path, "read error");
+  return contents.str();
+}
+
+bool ParseDouble(const std::string& token, double* value) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  *value = std::strtod(token.c_str(), &end);
+  return end == token.c_str() + token.size() && errno != ERANGE;
+}
+
+bool ParseInt(const std::string& token, int* value) {
+  if (token.empty()) return false;
+  char* end = nullptr;
+  errno = 0;
+  const long parsed = std::strtol(token.c_str(), &end, 10);
+  if (end != token.c_str() + token.size() || errno == ERANGE) return false;
+  if (parsed < std::numeric_limits<int>::min() || parsed > std::numeric_limits<int>::max()) {
+    return false;
+  }
+  *value = static_cast<int>(parsed);
+  return true;
+}
+
+std::vector<std::string> SplitWhitespace(const std::string& line) {
+  std::istringstream stream(line);
+  std::vector<std::string> tokens;
+  for (std::string token; stream >> token;) tokens.push_back(token);
+  return tokens;
+}
+
+void ValidateCameraExceptUnknownSize(const Camera& camera, const std::string& where) {
+  if (camera.width != 0 || camera.height != 0) {
+    camera.Validate(where);
+    return;
+  }
+  Camera sized = camera;
+  sized.width = sized.height = 1;  // Only the size check is skipped.
+  sized.Validate(where);
+}
+
+void RequireUniqueCameraNames(const std::vector<Camera>& cameras, const std::string& where) {
+  std::set<std::string> names;
+  for (const Camera& camera : cameras) {
+    Require(names.insert(camera.name).second, where,
+            "camera name '" + camera.name + "' appears twice");
+  }
+}
+
+}  // namespace internal
+}  // namespace finecap

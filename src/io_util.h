@@ -1,0 +1,35 @@
+// Small helpers shared by the file readers (not part of the public API).
+#ifndef FINECAP_SRC_IO_UTIL_H_
+#define FINECAP_SRC_IO_UTIL_H_
+
+#include <string>
+#include <vector>
+
+#include "finecap/camera.h"
+
+namespace finecap {
+namespace internal {
+
+// Throws Error(path, ...) unless `path` is an existing regular file.
+void RequireFile(const std::string& path);
+
+// The whole file as bytes. Throws Error naming the file when it is missing or unreadable.
+std::string ReadWholeFile(const std::string& path);
+
+// Parses the whole of `token` as a number; false when it is not one (or has trailing characters).
+bool ParseDouble(const std::string& token, double* value);
+bool ParseInt(const std::string& token, int* value);
+
+// Whitespace-separated tokens of `line`.
+std::vector<std::string> SplitWhitespace(const std::string& line);
+
+// Camera::Validate, except that a size of 0 x 0 (not yet known) is accepted.
+void ValidateCameraExceptUnknownSize(const Camera& camera, const std::string& where);
+
+// Throws Error(where, ...) when two cameras share a name.
+void RequireUniqueCameraNames(const std::vector<Camera>& cameras, const std::string& where);
+
+}  // namespace internal
+}  // namespace finecap
+
+#endif  // FINECAP_SRC_IO_UTIL_H_

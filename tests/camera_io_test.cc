@@ -1,0 +1,373 @@
+#include "finecap/camera_io.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "finecap/error.h"
+#include "test_util.h"
+
+namespace finecap {
+namespace {
+
+using testing_util::ExpectErrorMentions;
+using testing_util::MakeTempDir;
+using testing_util::WriteText;
+
+Camera MakeCamera(const std::string& name, double angle) {
+  Camera camera;
+  camera.name = name;
+  camera.width = 1004;
+  camera.height = 1002;
+  camera.K << 1234.5678901234567, 0.25, 501.123456789, 0.0, 1180.0000000001, 498.7, 0.0, 0.0, 1.0;
+  camera.R =
+      Eigen::AngleAxisd(angle, Eigen::Vector3d(0.2, 1.0, -0.1).normalized()).toRotationMatrix();
+  camera.t = Eigen::Vector3d(0.1 / 3.0, -0.2, 3.0 + 1e-13);
+  camera.distortion = {-0.21, 0.08, 0.001 / 7.0, -0.002, 0.01};
+  return camera;
+}
+
+void ExpectSameCamera(const Camera& expected, const Camera& actual) {
+  EXPECT_EQ(expected.name, actual.name);
+  EXPECT_EQ(expected.width, actual.width);
+  EXPECT_EQ(expected.height, actual.height);
+  EXPECT_EQ(expected.K, actual.K);
+  EXPECT_EQ(expected.R, actual.R);
+  EXPECT_EQ(expected.t, actual.t);
+  EXPECT_EQ(expected.distortion, actual.distortion);
+}
+
+// ---------------------------------------------------------------------------------------------
+// cameras.yaml
+
+TEST(CamerasYamlTest, RoundTripIsBitExact) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  const std::vector<Camera> cameras = {MakeCamera("cam0", 0.3), MakeCamera("cam 1: side", -2.1)};
+  WriteCamerasYaml(cameras, path);
+  const std::vector<Camera> read = ReadCamerasYaml(path);
+  ASSERT_EQ(read.size(), 2u);
+  for (size_t i = 0; i < read.size(); ++i) ExpectSameCamera(cameras[i], read[i]);
+}
+
+TEST(CamerasYamlTest, WrittenFileStatesTheConvention) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  WriteCamerasYaml({MakeCamera("cam0", 0.3)}, path);
+  std::ifstream stream(path);
+  std::string first_line;
+  std::getline(stream, first_line);
+  EXPECT_EQ(first_line.rfind("#", 0), 0u);
+  const std::string contents = first_line + std::string(std::istreambuf_iterator<char>(stream), {});
+  EXPECT_NE(contents.find("x_cam = R * X + t"), std::string::npos);
+  EXPECT_NE(contents.find("metres"), std::string::npos);
+  EXPECT_NE(contents.find("(0, 0)"), std::string::npos);
+}
+
+TEST(CamerasYamlTest, DistortionIsOptional) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  WriteText(path,
+            "cameras:\n"
+            "  - name: cam0\n    width: 640\n    height: 480\n"
+            "    K: [500, 0, 320, 0, 510, 240, 0, 0, 1]\n"
+            "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 2.5]\n");
+  const std::vector<Camera> cameras = ReadCamerasYaml(path);
+  ASSERT_EQ(cameras.size(), 1u);
+  EXPECT_FALSE(cameras[0].HasDistortion());
+  EXPECT_EQ(cameras[0].K(1, 1), 510.0);
+  EXPECT_EQ(cameras[0].t.z(), 2.5);
+}
+
+TEST(CamerasYamlTest, WriterRefusesAnInvalidCameraAndLeavesNoFile) {
+  const std::string dir = MakeTempDir("yaml");
+  Camera camera = MakeCamera("cam0", 0.3);
+  camera.R(0, 0) = 5.0;
+  ExpectErrorMentions([&] { WriteCamerasYaml({camera}, dir + "/cameras.yaml"); },
+                      {"cameras.yaml", "cam0", "rotation"});
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+}
+
+struct BadYamlCase {
+  const char* label;
+  std::string contents;
+  std::vector<std::string> expected_parts;  // Besides the file name.
+};
+void PrintTo(const BadYamlCase& c, std::ostream* os) { *os << c.label; }
+
+std::string CameraEntry(const std::string& name, const std::string& r, const std::string& extra) {
+  return "  - name: " + name + "\n    width: 640\n    height: 480\n" +
+         "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n    R: " + r + "\n    t: [0, 0, 2]\n" + extra;
+}
+
+const std::string kIdentity = "[1, 0, 0, 0, 1, 0, 0, 0, 1]";
+
+class BadCamerasYamlTest : public ::testing::TestWithParam<BadYamlCase> {};
+
+TEST_P(BadCamerasYamlTest, ErrorNamesFileAndProblem) {
+  const std::string path = MakeTempDir("bad_yaml") + "/cameras.yaml";
+  WriteText(path, GetParam().contents);
+  std::vector<std::string> parts = GetParam().expected_parts;
+  parts.push_back(path);
+  ExpectErrorMentions([&] { ReadCamerasYaml(path); }, parts);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadCamerasYamlTest,
+    ::testing::Values(
+        BadYamlCase{"Malformed", "cameras: [ {name: cam0, width: 640\n", {"malformed YAML"}},
+        BadYamlCase{"NoCameras", "rig: []\n", {"missing key 'cameras'"}},
+        BadYamlCase{"UnknownTopLevelKey",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity, "") + "units: mm\n",
+                    {"unknown top-level key 'units'"}},
+        BadYamlCase{"UnknownKey",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity, "    focal: 500\n"),
+                    {"cam0", "'focal'", "unknown key"}},
+        BadYamlCase{"MissingKey",
+                    "cameras:\n  - name: cam0\n    width: 640\n    height: 480\n"
+                    "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 2]\n",
+                    {"cam0", "'K'", "missing key"}},
+        BadYamlCase{
+            "WrongType",
+            "cameras:\n" + CameraEntry("cam0", kIdentity, "    distortion: [a, 0, 0, 0, 0]\n"),
+            {"cam0", "'distortion'", "must be a number"}},
+        BadYamlCase{"FractionalWidth",
+                    "cameras:\n  - name: cam0\n    width: 640.5\n    height: 480\n"
+                    "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
+                    "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 2]\n",
+                    {"cam0", "'width'", "must be an integer"}},
+        BadYamlCase{"WrongLength",
+                    "cameras:\n" + CameraEntry("cam0", "[1, 0, 0, 0, 1, 0]", ""),
+                    {"cam0", "'R'", "list of 9 numbers"}},
+        BadYamlCase{
+            "DuplicateName",
+            "cameras:\n" + CameraEntry("cam0", kIdentity, "") + CameraEntry("cam0", kIdentity, ""),
+            {"cam0", "appears twice"}},
+        BadYamlCase{"SingularR",
+                    "cameras:\n" + CameraEntry("cam0", "[0, 0, 0, 0, 0, 0, 0, 0, 0]", ""),
+                    {"cam0", "not a rotation"}},
+        BadYamlCase{"NonRotationR",
+                    "cameras:\n" + CameraEntry("cam0", "[2, 0, 0, 0, 1, 0, 0, 0, 1]", ""),
+                    {"cam0", "not a rotation"}},
+        BadYamlCase{"ReflectionR",
+                    "cameras:\n" + CameraEntry("cam0", "[-1, 0, 0, 0, 1, 0, 0, 0, 1]", ""),
+                    {"cam0", "not a rotation"}}),
+    [](const ::testing::TestParamInfo<BadYamlCase>& info) { return info.param.label; });
+
+TEST(CamerasYamlTest, MissingFileIsNamed) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  ExpectErrorMentions([&] { ReadCamerasYaml(path); }, {path, "not found"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// COLMAP text model
+
+// COLMAP's own projection of a camera-space point for each supported model, written from COLMAP's
+// model definitions; pixel centres at +0.5.
+Eigen::Vector2d ColmapProject(const std::string& model, const std::vector<double>& p,
+                              const Eigen::Vector3d& camera_point) {
+  const double x = camera_point.x() / camera_point.z();
+  const double y = camera_point.y() / camera_point.z();
+  const double r2 = x * x + y * y;
+  double fx = p[0], fy = p[0], cx = p[1], cy = p[2];
+  double xd = x, yd = y;
+  if (model == "PINHOLE" || model == "OPENCV") fy = p[1], cx = p[2], cy = p[3];
+  if (model == "SIMPLE_RADIAL") xd = x * (1 + p[3] * r2), yd = y * (1 + p[3] * r2);
+  if (model == "RADIAL") {
+    const double radial = 1 + p[3] * r2 + p[4] * r2 * r2;
+    xd = x * radial, yd = y * radial;
+  }
+  if (model == "OPENCV") {
+    const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];
+    const double radial = 1 + k1 * r2 + k2 * r2 * r2;
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+    yd = y * radial + 2 * p2 * x * y + p1 * (r2 + 2 * y * y);
+  }
+  return Eigen::Vector2d(fx * xd + cx, fy * yd + cy);
+}
+
+struct ColmapModelCase {
+  std::string model;
+  std::vector<double> params;
+};
+void PrintTo(const ColmapModelCase& c, std::ostream* os) { *os << c.model; }
+
+class ColmapModelTest : public ::testing::TestWithParam<ColmapModelCase> {};
+
+TEST_P(ColmapModelTest, ProjectsLikeColmapShiftedByHalfAPixel) {
+  const ColmapModelCase& c = GetParam();
+  const std::string dir = MakeTempDir("colmap");
+  std::ostringstream params;
+  params.precision(17);
+  for (double value : c.params) params << " " << value;
+  WriteText(dir + "/cameras.txt", "# Camera list\n7 " + c.model + " 800 600" + params.str() + "\n");
+  const Eigen::Quaterniond q =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 2, 3).normalized()));
+  const Eigen::Vector3d t(0.1, -0.3, 4.0);
+  std::ostringstream images;
+  images.precision(17);
+  images << "# Image list\n\n3 " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+         << t.x() << " " << t.y() << " " << t.z() << " 7 rig/cam03/000000.jpg\n"
+         << "10.5 20.5 -1 30.5 40.5 12\n";
+  WriteText(dir + "/images.txt", images.str());
+
+  const std::vector<Camera> cameras = ReadColmapTextModel(dir);
+  ASSERT_EQ(cameras.size(), 1u);
+  EXPECT_EQ(cameras[0].name, "cam03");
+  EXPECT_EQ(cameras[0].width, 800);
+  EXPECT_EQ(cameras[0].height, 600);
+  for (const Eigen::Vector3d& point :
+       {Eigen::Vector3d(0.2, -0.1, 0.3), Eigen::Vector3d(-0.5, 0.4, -0.2),
+        Eigen::Vector3d(0, 0, 0)}) {
+    const Eigen::Vector2d colmap = ColmapProject(c.model, c.params, q * point + t);
+    const Eigen::Vector2d ours = cameras[0].Project(point);
+    EXPECT_NEAR(ours.x(), colmap.x() - 0.5, 1e-9) << c.model;
+    EXPECT_NEAR(ours.y(), colmap.y() - 0.5, 1e-9) << c.model;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Models, ColmapModelTest,
+    ::testing::Values(ColmapModelCase{"SIMPLE_PINHOLE", {700, 401, 299}},
+                      ColmapModelCase{"PINHOLE", {700, 710, 401, 299}},
+                      ColmapModelCase{"SIMPLE_RADIAL", {700, 401, 299, -0.12}},
+                      ColmapModelCase{"RADIAL", {700, 401, 299, -0.12, 0.03}},
+                      ColmapModelCase{"OPENCV", {700, 710, 401, 299, -0.12, 0.03, 0.002, -0.001}}),
+    [](const ::testing::TestParamInfo<ColmapModelCase>& info) { return info.param.model; });
+
+TEST(ColmapTextModelTest, NamesCamerasAndTakesTheSmallestImageIdPerCamera) {
+  const std::string dir = MakeTempDir("colmap");
+  WriteText(dir + "/cameras.txt",
+            "1 PINHOLE 640 480 500 500 320 240\n2 PINHOLE 640 480 600 600 320 240\n");
+  WriteText(dir + "/images.txt",
+            "# two lines per image\n"
+            "5 1 0 0 0 9 9 9 1 cam1/000001.png\n\n"
+            "2 1 0 0 0 0 0 1 2 side.png\n"
+            "\n"
+            "4 1 0 0 0 0 0 2 1 cam1/000000.png\n"
+            "1.0 2.0 -1\n");
+  const std::vector<Camera> cameras = ReadColmapTextModel(dir);
+  ASSERT_EQ(cameras.size(), 2u);
+  EXPECT_EQ(cameras[0].name, "side");
+  EXPECT_EQ(cameras[0].fx(), 600.0);
+  EXPECT_EQ(cameras[1].name, "cam1");
+  EXPECT_EQ(cameras[1].t, Eigen::Vector3d(0, 0, 2));  // IMAGE_ID 4, not 5.
+  EXPECT_EQ(cameras[1].K(0, 2), 319.5);
+}
+
+TEST(ColmapTextModelTest, BadInputsNameTheFileAndProblem) {
+  const std::string dir = MakeTempDir("colmap");
+  const std::string good_images = "1 1 0 0 0 0 0 1 1 cam0.png\n\n";
+  WriteText(dir + "/images.txt", good_images);
+  WriteText(dir + "/cameras.txt", "1 FULL_OPENCV 640 480 1 1 1 1 0 0 0 0 0 0 0 0\n");
+  ExpectErrorMentions([&] { ReadColmapTextModel(dir); },
+                      {"cameras.txt line 1", "unsupported camera model 'FULL_OPENCV'"});
+  WriteText(dir + "/cameras.txt", "# header\n1 PINHOLE 640 480 500 500 320\n");
+  ExpectErrorMentions([&] { ReadColmapTextModel(dir); },
+                      {"cameras.txt line 2", "takes 4 parameters, not 3"});
+  WriteText(dir + "/cameras.txt", "2 PINHOLE 640 480 500 500 320 240\n");
+  ExpectErrorMentions([&] { ReadColmapTextModel(dir); }, {"images.txt", "CAMERA_ID 1"});
+  WriteText(dir + "/cameras.txt", "1 PINHOLE 640 480 500 500 320 240\n");
+  WriteText(dir + "/images.txt", "1 2 0 0 0 0 0 1 1 cam0.png\n\n");
+  ExpectErrorMentions([&] { ReadColmapTextModel(dir); }, {"images.txt line 1", "unit length"});
+  std::filesystem::remove(dir + "/images.txt");
+  ExpectErrorMentions([&] { ReadColmapTextModel(dir); }, {"images.txt", "not found"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// intri.yml / extri.yml
+
+cv::Mat ToCv(const Eigen::Matrix3d& matrix) {
+  cv::Mat result(3, 3, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) result.at<double>(r, c) = matrix(r, c);
+  return result;
+}
+
+// Writes a two-camera rig as EasyMocap does: cam0 with a Rodrigues R_ and its size, cam1 with a
+// Rot_ matrix, a 4x1 distortion and no size.
+void WriteIntriExtri(const std::string& dir, const Camera& cam0, const Camera& cam1) {
+  cv::FileStorage intri(dir + "/intri.yml", cv::FileStorage::WRITE);
+  intri << "names" << std::vector<std::string>{cam0.name, cam1.name};
+  intri << "K_" + cam0.name << ToCv(cam0.K);
+  intri << "dist_" + cam0.name
+        << cv::Mat(1, 5, CV_64F, const_cast<double*>(cam0.distortion.data()));
+  intri << "H_" + cam0.name << cam0.height << "W_" + cam0.name << cam0.width;
+  intri << "K_" + cam1.name << ToCv(cam1.K);
+  intri << "dist_" + cam1.name
+        << cv::Mat(4, 1, CV_64F, const_cast<double*>(cam1.distortion.data()));
+  intri.release();
+  cv::FileStorage extri(dir + "/extri.yml", cv::FileStorage::WRITE);
+  cv::Mat rvec;
+  cv::Rodrigues(ToCv(cam0.R), rvec);
+  extri << "names" << std::vector<std::string>{cam0.name, cam1.name};
+  extri << "R_" + cam0.name << rvec;
+  extri << "T_" + cam0.name << (cv::Mat_<double>(3, 1) << cam0.t.x(), cam0.t.y(), cam0.t.z());
+  extri << "Rot_" + cam1.name << ToCv(cam1.R);
+  extri << "T_" + cam1.name << (cv::Mat_<double>(3, 1) << cam1.t.x(), cam1.t.y(), cam1.t.z());
+}
+
+TEST(IntriExtriTest, ReadsWhatFileStorageWrote) {
+  const std::string dir = MakeTempDir("intri");
+  const Camera cam0 = MakeCamera("01", 0.3);
+  Camera cam1 = MakeCamera("02", -1.0);
+  cam1.distortion[4] = 0.0;  // Only four coefficients are stored.
+  WriteIntriExtri(dir, cam0, cam1);
+
+  const std::vector<Camera> cameras = ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml");
+  ASSERT_EQ(cameras.size(), 2u);
+  EXPECT_EQ(cameras[0].name, "01");
+  EXPECT_EQ(cameras[0].width, cam0.width);
+  EXPECT_EQ(cameras[0].height, cam0.height);
+  EXPECT_EQ(cameras[0].K, cam0.K);
+  EXPECT_LT((cameras[0].R - cam0.R).norm(), 1e-12);  // Through a rotation vector.
+  EXPECT_EQ(cameras[0].t, cam0.t);
+  EXPECT_EQ(cameras[0].distortion, cam0.distortion);
+  EXPECT_EQ(cameras[1].width, 0);  // No H_/W_: taken from the first image later.
+  EXPECT_EQ(cameras[1].height, 0);
+  EXPECT_EQ(cameras[1].R, cam1.R);
+  EXPECT_EQ(cameras[1].distortion, cam1.distortion);
+}
+
+TEST(IntriExtriTest, BadInputsNameTheFileAndKey) {
+  const std::string dir = MakeTempDir("intri");
+  Camera cam1 = MakeCamera("cam1", -1.0);
+  cam1.R(1, 1) = 3.0;
+  WriteIntriExtri(dir, MakeCamera("cam0", 0.3), cam1);
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {"extri.yml", "cam1", "not a rotation"});
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/missing.yml"); },
+                      {"missing.yml", "not found"});
+  WriteText(dir + "/bad.yml", "%YAML:1.0\n---\nnames: [cam0\nK_cam0: !!opencv-matrix {\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/bad.yml", dir + "/extri.yml"); },
+                      {"bad.yml", "malformed"});
+  WriteText(dir + "/nok.yml", "%YAML:1.0\n---\nnames: [cam0]\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/nok.yml", dir + "/extri.yml"); },
+                      {"nok.yml", "K_cam0", "missing key"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// ReadRig
+
+TEST(ReadRigTest, FindsEachFormat) {
+  const std::string yaml_dir = MakeTempDir("rig");
+  WriteCamerasYaml({MakeCamera("cam0", 0.3)}, yaml_dir + "/cameras.yaml");
+  EXPECT_EQ(ReadRig(yaml_dir).at(0).name, "cam0");
+
+  const std::string intri_dir = MakeTempDir("rig");
+  WriteIntriExtri(intri_dir, MakeCamera("a", 0.3), MakeCamera("b", 0.1));
+  EXPECT_EQ(ReadRig(intri_dir).size(), 2u);
+
+  const std::string colmap_dir = MakeTempDir("rig");
+  WriteText(colmap_dir + "/sparse/0/cameras.txt", "1 PINHOLE 640 480 500 500 320 240\n");
+  WriteText(colmap_dir + "/sparse/0/images.txt", "1 1 0 0 0 0 0 1 1 c/0.png\n\n");
+  EXPECT_EQ(ReadRig(colmap_dir).at(0).name, "c");
+
+  const std::string empty_dir = MakeTempDir("rig");
+  ExpectErrorMentions([&] { ReadRig(empty_dir); }, {empty_dir, "no camera rig found"});
+  ExpectErrorMentions([&] { ReadRig(empty_dir + "/nowhere"); }, {"nowhere", "not found"});
+}
+
+}  // namespace
+}  // namespace finecap

@@ -1,0 +1,56 @@
+// Helpers shared by the I/O tests: temporary folders, small files, error-message checks.
+#ifndef FINECAP_TESTS_TEST_UTIL_H_
+#define FINECAP_TESTS_TEST_UTIL_H_
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "finecap/error.h"
+
+namespace finecap {
+namespace testing_util {
+
+// A fresh, empty folder under the test temp dir, unique per process and call.
+inline std::string MakeTempDir(const std::string& name) {
+  static int counter = 0;
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) /
+      ("finecap_" + name + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+inline void WriteText(const std::string& path, const std::string& contents) {
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::ofstream stream(path, std::ios::binary);
+  stream << contents;
+  ASSERT_TRUE(static_cast<bool>(stream)) << path;
+}
+
+// Expects `action` to throw finecap::Error whose message contains every one of `parts`.
+inline void ExpectErrorMentions(const std::function<void()>& action,
+                                const std::vector<std::string>& parts) {
+  try {
+    action();
+    ADD_FAILURE() << "expected finecap::Error mentioning '" << parts.front() << "'";
+  } catch (const Error& error) {
+    const std::string message = error.what();
+    for (const std::string& part : parts) {
+      EXPECT_NE(message.find(part), std::string::npos)
+          << "message '" << message << "' lacks '" << part << "'";
+    }
+  }
+}
+
+}  // namespace testing_util
+}  // namespace finecap
+
+#endif  // FINECAP_TESTS_TEST_UTIL_H_
