@@ -19,13 +19,10 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing_util::ExpectErrorMentions;
+using testing_util::FileBytes;
+using testing_util::FilesIn;
 using testing_util::MakeTempDir;
 using testing_util::WriteText;
-
-std::string FileBytes(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
-}
 
 // Sample s of a small animation: point p at (p + s, 2p - s, 0.001 p s).
 Eigen::Matrix3Xd Sample(int s, int num_points) {
@@ -39,12 +36,6 @@ void WriteCache(const std::string& path, int num_samples, int num_points) {
   for (int s = 0; s < num_samples; ++s) writer.Append(Sample(s, num_points));
   EXPECT_EQ(writer.num_samples(), num_samples);
   writer.Finish();
-}
-
-std::vector<std::string> FilesIn(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
-  return names;
 }
 
 TEST(ExportPc2, HeaderBytesAreLiterallyTheFormat) {

@@ -16,6 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing_util::ExpectErrorMentions;
+using testing_util::FilesIn;
 using testing_util::MakeTempDir;
 
 PlotSeries Line(const std::string& name, double slope) {
@@ -35,13 +36,6 @@ PlotOptions SmallPlot() {
   options.width = 320;
   options.height = 240;
   return options;
-}
-
-// No file other than the expected ones is left in `dir` (no temporary, no stray output).
-std::vector<std::string> FilesIn(const std::string& dir) {
-  std::vector<std::string> names;
-  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
-  return names;
 }
 
 TEST(Plot, DetectsAPngTerminal) {
