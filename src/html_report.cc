@@ -1,6 +1,8 @@
 #include "finecap/html_report.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 
 #include <opencv2/imgcodecs.hpp>

@@ -24,12 +24,13 @@ using testing_util::WriteText;
 std::string Base64Decode(const std::string& text) {
   const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string bytes;
-  int bits = 0, bit_count = 0;
+  unsigned bits = 0;  // Only the low bit_count bits are pending.
+  int bit_count = 0;
   for (char c : text) {
     if (c == '=') break;
     const size_t value = alphabet.find(c);
     EXPECT_NE(value, std::string::npos) << "not base64: " << c;
-    bits = (bits << 6) | static_cast<int>(value);
+    bits = ((bits << 6) | static_cast<unsigned>(value)) & 0xfffu;
     bit_count += 6;
     if (bit_count >= 8) {
       bit_count -= 8;

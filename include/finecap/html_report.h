@@ -5,6 +5,7 @@
 
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -25,7 +26,8 @@ class TableCell {
  public:
   TableCell(const char* text) : text_(text) {}         // NOLINT: implicit by design.
   TableCell(const std::string& text) : text_(text) {}  // NOLINT
-  template <typename Number, typename = std::enable_if_t<std::is_arithmetic_v<Number>>>
+  template <typename Number, typename = std::enable_if_t<std::is_arithmetic_v<Number> &&
+                                                         !std::is_same_v<Number, bool>>>
   TableCell(Number number)  // NOLINT
       : text_(std::is_integral_v<Number> ? std::to_string(number)
                                          : FormatNumber(static_cast<double>(number), 4)),
