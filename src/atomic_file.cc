@@ -9,26 +9,33 @@
 
 namespace finecap {
 
-void WriteFileAtomically(const std::string& path,
-                         const std::function<void(const std::string& temporary_path)>& write) {
-  namespace fs = std::filesystem;
-  // Keep the extension last: some writers (OpenCV, assimp) choose the format by it.
-  const fs::path target(path);
-  const fs::path temporary = target.parent_path() / (".tmp-" + std::to_string(getpid()) + "-" +
-                                                     target.filename().string());
-  try {
-    write(temporary.string());
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(temporary, ignored);
-    throw;
-  }
+std::string TemporaryPathFor(const std::string& path) {
+  const std::filesystem::path target(path);
+  return (target.parent_path() /
+          (".tmp-" + std::to_string(getpid()) + "-" + target.filename().string()))
+      .string();
+}
+
+void MoveIntoPlace(const std::string& temporary_path, const std::string& path) {
   std::error_code error;
-  fs::rename(temporary, target, error);
+  std::filesystem::rename(temporary_path, path, error);
   if (error) {
-    fs::remove(temporary, error);
+    std::filesystem::remove(temporary_path, error);
     throw Error(path, "cannot move the finished file into place");
   }
+}
+
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(const std::string& temporary_path)>& write) {
+  const std::string temporary = TemporaryPathFor(path);
+  try {
+    write(temporary);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+  MoveIntoPlace(temporary, path);
 }
 
 void WriteTextFileAtomically(const std::string& path, const std::string& contents) {

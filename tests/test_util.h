@@ -4,9 +4,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,22 @@ inline void WriteText(const std::string& path, const std::string& contents) {
   std::ofstream stream(path, std::ios::binary);
   stream << contents;
   ASSERT_TRUE(static_cast<bool>(stream)) << path;
+}
+
+// The whole file as bytes; empty when it cannot be read.
+inline std::string FileBytes(const std::string& path) {
+  std::ifstream stream(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(stream), std::istreambuf_iterator<char>());
+}
+
+// The names of the entries of `dir`, sorted: shows that no temporary or stray file is left.
+inline std::vector<std::string> FilesIn(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 // Expects `action` to throw finecap::Error whose message contains every one of `parts`.

@@ -16,6 +16,16 @@ void WriteFileAtomically(const std::string& path,
 // Writes `contents` to `path` atomically. Throws Error naming the path on failure.
 void WriteTextFileAtomically(const std::string& path, const std::string& contents);
 
+// The two halves of WriteFileAtomically, for a writer that keeps its file open across calls
+// (e.g. a streamed point cache). TemporaryPathFor names the temporary: in the folder of `path`,
+// so the final rename stays on one file system, and ending in the same file name, so writers
+// that choose the format by the extension still do.
+std::string TemporaryPathFor(const std::string& path);
+
+// Renames the finished `temporary_path` to `path`. On failure removes the temporary and throws
+// Error naming `path`.
+void MoveIntoPlace(const std::string& temporary_path, const std::string& path);
+
 }  // namespace finecap
 
 #endif  // FINECAP_ATOMIC_FILE_H_
