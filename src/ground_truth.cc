@@ -21,15 +21,4 @@ Eigen::VectorXd TrueDisplacementAlongNormals(const Eigen::Matrix3Xd& vertices,
   return displacement;
 }
 
-double RootMeanSquare(const Eigen::VectorXd& values, const std::vector<int>& indices) {
-  double sum = 0.0;
-  int count = 0;
-  for (int i : indices) {
-    if (!std::isfinite(values[i])) continue;
-    sum += values[i] * values[i];
-    ++count;
-  }
-  return count > 0 ? std::sqrt(sum / count) : std::nan("");
-}
-
 }  // namespace finecap

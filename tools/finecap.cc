@@ -23,6 +23,7 @@ DEFINE_string(capture, "", "Capture folder; overrides capture.dir.");
 DEFINE_string(out, "", "Output folder; overrides output.dir.");
 DEFINE_string(frames, "", "Frames to process, A:B (indices A..B-1); overrides capture.frames.");
 DEFINE_int32(threads, -1, "Worker threads (0 = all cores); overrides runtime.threads.");
+DEFINE_int32(frame, -1, "probe: the frame (index) to probe; -1 = the last.");
 DEFINE_string(set, "",
               "Overrides of any config keys, comma separated: "
               "--set output.mesh_format=obj,runtime.threads=2");
@@ -43,6 +44,12 @@ const std::vector<Subcommand>& Subcommands() {
       {"synth", "Generate a synthetic capture with ground truth (cameras, images, meshes, gt/).",
        "finecap synth --config configs/synth_demo.yaml --out data/demo", &RunSynth,
        {"config", "out", "set"}},
+      {"probe",
+       "Diagnostic: the configured energy along k = alpha * k_true on a frame with ground truth; "
+       "ends with alpha_optimum.",
+       "finecap probe --config FILE --capture DIR [--frame N] [--out DIR]",
+       [](const Config& config) { return RunProbe(config, FLAGS_frame); },
+       {"config", "capture", "out", "frame", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
        "finecap refine --config configs/demo.yaml [--frames A:B] [--capture DIR] [--out DIR]",

@@ -11,6 +11,11 @@ namespace finecap {
 // Loads the capture, refines the configured frames and writes the results to output.dir.
 int RunRefine(const Config& config);
 
+// Evaluates the configured energy on frame `frame` (-1: the last) of a capture with ground truth
+// along k = alpha * k_true, alpha in [-0.5, 1.5]; prints the table, plots it into output.dir (or
+// the working directory) and ends with the line "alpha_optimum: <value>".
+int RunProbe(const Config& config, int frame);
+
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 

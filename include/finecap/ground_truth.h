@@ -15,9 +15,6 @@ Eigen::VectorXd TrueDisplacementAlongNormals(const Eigen::Matrix3Xd& vertices,
                                              const Eigen::Matrix3Xd& normals, const Mesh& truth,
                                              double max_distance);
 
-// Root mean square of the finite entries of `values` at `indices`; NaN when there is none.
-double RootMeanSquare(const Eigen::VectorXd& values, const std::vector<int>& indices);
-
 }  // namespace finecap
 
 #endif  // FINECAP_GROUND_TRUTH_H_

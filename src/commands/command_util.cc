@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -55,7 +56,18 @@ FrameInput ReadFrameInput(Capture* capture, int frame) {
 
 ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
                                              Capture* capture, const std::string& path) {
-  if (fs::exists(path)) return ReadReferenceColors(path, model.num_fine_vertices());
+  if (fs::exists(path)) {
+    ReferenceColors saved = ReadReferenceColors(path, model.num_fine_vertices());
+    const RefineOptions& options = config.refine;
+    Require(saved.color_space == options.image.color_space &&
+                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-12 * options.sigma_hat,
+            path,
+            "was made for colour space " + ColorSpaceName(saved.color_space) + " and sigma_hat " +
+                std::to_string(saved.sigma_hat) + ", but the config asks for " +
+                ColorSpaceName(options.image.color_space) + " and " +
+                std::to_string(options.sigma_hat) + ": use another output folder");
+    return saved;
+  }
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
           "frame " + std::to_string(config.reference_frame) + " does not exist in " +
               capture->directory());

@@ -9,7 +9,7 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
-#include "finecap/ground_truth.h"
+#include "finecap/metrics.h"
 #include "finecap/mesh_io.h"
 
 namespace finecap {
@@ -64,10 +64,9 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
   const Eigen::VectorXd truth = internal::TrueFineDisplacement(capture, model, coarse, frame);
   if (truth.size() == 0) return;
   // Only where the result has a displacement: both figures over the same vertices.
-  Eigen::VectorXd refined_error = result.k - truth;
-  Eigen::VectorXd coarse_error = (result.k.array().isFinite()).select(-truth, std::nan(""));
-  stats->rms_coarse_mm = 1000.0 * RootMeanSquare(coarse_error, textured);
-  stats->rms_refined_mm = 1000.0 * RootMeanSquare(refined_error, textured);
+  const Eigen::VectorXd input = result.k.array().isFinite().select(0.0 * result.k, result.k);
+  stats->rms_coarse_mm = 1000.0 * ComputeErrorStats(input, truth, textured).rms;
+  stats->rms_refined_mm = 1000.0 * ComputeErrorStats(result.k, truth, textured).rms;
 }
 
 void PrintProblemSize(const Capture& capture, const SequenceModel& model, int frames) {
