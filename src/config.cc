@@ -70,8 +70,9 @@ void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
                     "colour against the image around its projection (peaks at the truth).",
                     {"paper", "surface_color"});
   schema->AddChoice("energy.overlap", &energy->overlap,
-                    "Overlap of two Gaussians: the paper's printed form or the exact integral.",
-                    {"printed", "exact"});
+                    "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
+                    "patch (image Gaussians as the squares they stand for).",
+                    {"printed", "exact", "patch"});
   schema->AddDouble("energy.color_cutoff", &energy->color_cutoff,
                     "Wendland cut-off D of the colour weight of the paper's E_sim (paper: 0.05).",
                     1e-6, 10.0);

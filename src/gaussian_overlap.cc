@@ -7,7 +7,8 @@ namespace finecap {
 OverlapForm ParseOverlapForm(const std::string& name) {
   if (name == "printed") return OverlapForm::kPrinted;
   if (name == "exact") return OverlapForm::kExact;
-  throw Error("energy.overlap", "'" + name + "' is not one of: printed, exact");
+  if (name == "patch") return OverlapForm::kPatch;
+  throw Error("energy.overlap", "'" + name + "' is not one of: printed, exact, patch");
 }
 
 }  // namespace finecap

@@ -21,7 +21,11 @@
 
 namespace finecap {
 
-enum class OverlapForm { kPrinted, kExact };
+// kPatch treats an image Gaussian as what it stands for, a square of side 2 sigma_i of uniform
+// colour: a square's variance is sigma_i^2 / 3 per axis, so S = sigma_s^2 + sigma_i^2 / 3 and the
+// exponent is the exact one, -|d|^2 / (2S). Then the overlap-weighted mean colour of the image
+// Gaussians is the image blurred by the surface Gaussian (up to the squares' shape).
+enum class OverlapForm { kPrinted, kExact, kPatch };
 
 OverlapForm ParseOverlapForm(const std::string& name);  // "printed" or "exact".
 
@@ -35,7 +39,12 @@ struct ProjectedGaussian {
 };
 
 // 1 for the printed form's exponent -|d|^2/S, 2 for the exact -|d|^2/(2S).
-inline double ExponentDivisor(OverlapForm form) { return form == OverlapForm::kExact ? 2.0 : 1.0; }
+inline double ExponentDivisor(OverlapForm form) { return form == OverlapForm::kPrinted ? 1.0 : 2.0; }
+
+// The weight of sigma_i^2 in S.
+inline double ImageVarianceFactor(OverlapForm form) {
+  return form == OverlapForm::kPatch ? 1.0 / 3.0 : 1.0;
+}
 
 // The overlap E of a projected surface Gaussian with an image Gaussian (mean `image_mean`, standard
 // deviation `image_sigma`). When `dE_dk` is not null it receives dE/dk.
@@ -44,7 +53,7 @@ inline double GaussianOverlap(OverlapForm form, const ProjectedGaussian& surface
                               double* dE_dk = nullptr) {
   const double var_s = surface.sigma * surface.sigma;
   const double var_i = image_sigma * image_sigma;
-  const double sum = var_s + var_i;
+  const double sum = var_s + ImageVarianceFactor(form) * var_i;
   const Eigen::Vector2d d = image_mean - surface.mean;
   const double c = ExponentDivisor(form);
   const double d2 = d.squaredNorm();
