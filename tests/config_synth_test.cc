@@ -20,6 +20,13 @@ namespace {
 
 using testing_util::ExpectErrorMentions;
 
+// Expects `--set key=value` to be refused with an Error naming the override, the key and `parts`.
+void ExpectSetRefused(const std::string& key, const std::string& value,
+                      std::vector<std::string> parts) {
+  parts.insert(parts.begin(), "--set: key '" + key);
+  ExpectErrorMentions([&] { LoadConfig("", {{key, value, "--set"}}); }, parts);
+}
+
 std::vector<std::string> SynthPresets() {
   std::vector<std::string> presets;
   const std::filesystem::path configs = std::filesystem::path(FINECAP_SOURCE_DIR) / "configs";
@@ -231,11 +238,7 @@ TEST(ConfigSynthTest, UnknownSynthKeyIsNamed) {
   const std::string file = WriteConfig("unknown_synth.yaml", "synth:\n  cameras:\n    cont: 3\n");
   ExpectErrorMentions([&] { LoadConfig(file, {}); },
                       {"unknown_synth.yaml", "synth.cameras.cont", "unknown key"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.sead", "3", "--set"}});
-      },
-      {"--set", "synth.sead", "unknown key"});
+  ExpectSetRefused("synth.sead", "3", {"unknown key"});
 }
 
 TEST(ConfigSynthTest, WrongTypeInAFoldNamesTheFoldField) {
@@ -247,19 +250,16 @@ TEST(ConfigSynthTest, WrongTypeInAFoldNamesTheFoldField) {
 }
 
 TEST(ConfigSynthTest, BadFoldsAreRefusedWithTheirPath) {
-  const auto set_folds = [](const std::string& value) {
-    return [value] { LoadConfig("", {{"synth.folds", value, "--set"}}); };
-  };
-  ExpectErrorMentions(set_folds("[{wavelenth: 0.1}]"),
-                      {"--set", "synth.folds[0].wavelenth", "unknown fold key"});
-  ExpectErrorMentions(set_folds("[{}, {profile: square}]"),
-                      {"synth.folds[1].profile", "'square'", "sine, ridge"});
-  ExpectErrorMentions(set_folds("[{amplitude: 0.5}]"),
-                      {"synth.folds[0].amplitude", "outside [-0.1, 0.1]"});
-  ExpectErrorMentions(set_folds("[{drift: [1, 2]}]"),
-                      {"synth.folds[0].drift", "expected a single value"});
-  ExpectErrorMentions(set_folds("[0.1]"), {"synth.folds[0]'", "expected a mapping"});
-  ExpectErrorMentions(set_folds("0.1"), {"synth.folds'", "expected a list"});
+  ExpectSetRefused("synth.folds", "[{wavelenth: 0.1}]",
+                   {"synth.folds[0].wavelenth'", "unknown fold key"});
+  ExpectSetRefused("synth.folds", "[{}, {profile: square}]",
+                   {"synth.folds[1].profile'", "'square'", "sine, ridge"});
+  ExpectSetRefused("synth.folds", "[{amplitude: 0.5}]",
+                   {"synth.folds[0].amplitude'", "outside [-0.1, 0.1]"});
+  ExpectSetRefused("synth.folds", "[{drift: [1, 2]}]",
+                   {"synth.folds[0].drift'", "expected a single value"});
+  ExpectSetRefused("synth.folds", "[0.1]", {"synth.folds[0]'", "expected a mapping"});
+  ExpectSetRefused("synth.folds", "0.1", {"synth.folds'", "expected a list"});
 }
 
 TEST(ConfigSynthTest, FixedLengthListsCheckTheirLength) {
@@ -267,39 +267,15 @@ TEST(ConfigSynthTest, FixedLengthListsCheckTheirLength) {
       WriteConfig("distortion.yaml", "synth:\n  cameras:\n    distortion: [0.1, 0.0, 0.0, 0.0]\n");
   ExpectErrorMentions([&] { LoadConfig(file, {}); },
                       {"distortion.yaml", "synth.cameras.distortion", "exactly 5", "got 4"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.texture.textureless_color", "[0.5, 0.5]", "--set"}});
-      },
-      {"synth.texture.textureless_color", "exactly 3", "got 2"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.render.background", "[0.5, 2, 0]", "--set"}});
-      },
-      {"synth.render.background", "outside [0, 1]"});
+  ExpectSetRefused("synth.texture.textureless_color", "[0.5, 0.5]", {"exactly 3", "got 2"});
+  ExpectSetRefused("synth.render.background", "[0.5, 2, 0]", {"outside [0, 1]"});
 }
 
 TEST(ConfigSynthTest, BadSeedsAndChoicesAreRefused) {
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.seed", "-1", "--set"}});
-      },
-      {"synth.seed", "expected an integer"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.render.noise_seed", "18446744073709551616", "--set"}});
-      },
-      {"synth.render.noise_seed", "expected an integer"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.subject", "dress", "--set"}});
-      },
-      {"synth.subject", "skirt, mesh"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"synth.skirt.around", "4", "--set"}});
-      },
-      {"synth.skirt.around", "outside [8, 100000]"});
+  ExpectSetRefused("synth.seed", "-1", {"expected an integer"});
+  ExpectSetRefused("synth.render.noise_seed", "18446744073709551616", {"expected an integer"});
+  ExpectSetRefused("synth.subject", "dress", {"skirt, mesh"});
+  ExpectSetRefused("synth.skirt.around", "4", {"outside [8, 100000]"});
 }
 
 }  // namespace
