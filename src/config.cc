@@ -32,6 +32,10 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
   schema->AddDouble("model.sigma_hat", &refine.sigma_hat,
                     "Standard deviation of every surface Gaussian, metres (paper: 0.007).", 1e-5,
                     1.0);
+  schema->AddChoice("model.reference_colors", &refine.reference_colors,
+                    "How the reference frame colours the surface Gaussians: pixels (the paper) or "
+                    "image_model (what the energy's image model shows in the best camera).",
+                    {"pixels", "image_model"});
   schema->AddBool("model.bias_compensation", &refine.bias_compensation,
                   "Add sigma_hat along the normal after solving (the paper's shrink "
                   "compensation).");
@@ -115,6 +119,13 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                     0.999);
   schema->AddDouble("solver.max_step", &solver->max_step,
                     "Gradient ascent: largest step of one k_s in one iteration, m.", 1e-9, 1.0);
+  schema->AddInt("solver.sweep_samples", &refine->sweep.samples,
+                 "Plane-sweep start: displacements tried per surface Gaussian before solving "
+                 "(0 = off, start at k = 0).",
+                 0, 1000);
+  schema->AddInt("solver.sweep_smoothing_rounds", &refine->sweep.smoothing_rounds,
+                 "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0,
+                 1000);
   schema->AddBool("refine.keep_input_if_worse", &refine->keep_input_if_worse,
                   "Write the input surface for a frame whose energy got worse (always flagged).");
   schema->AddBool("refine.warm_start", &refine->warm_start,

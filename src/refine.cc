@@ -35,10 +35,13 @@ void RefineOptions::Check() const {
   Require(subdivision_levels >= 0 && subdivision_levels <= 4, "model.subdivision_levels",
           "must lie in [0, 4]");
   Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
+  Require(reference_colors == "pixels" || reference_colors == "image_model",
+          "model.reference_colors", "must be pixels or image_model");
   image.Check();
   visibility.Check();
   energy.Check();
   solver.Check();
+  sweep.Check();
 }
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
@@ -76,6 +79,15 @@ ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInp
   const Mesh fine = model.Subdivide(reference.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
   const auto visible = ComputeFrameVisibility(fine, normals, reference.cameras, options.visibility);
+  if (options.reference_colors == "image_model") {
+    std::vector<std::string> names;
+    for (const Camera& camera : reference.cameras) names.push_back(camera.name);
+    const std::vector<ImageGaussians> images =
+        BuildFrameImageGaussians(reference.images, {}, options.image, names);
+    return ComputeModelReferenceColors(fine.vertices, normals, reference.cameras, images, visible,
+                                       options.sigma_hat, ParseOverlapForm(options.energy.overlap),
+                                       options.energy.reach_sigmas);
+  }
   return ComputeReferenceColors(fine.vertices, normals, reference.cameras, reference.images,
                                 visible, options.image.color_space, options.sigma_hat);
 }
@@ -119,7 +131,7 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.num_pairs = energy.num_pairs();
   result.seconds_preparation = frame.seconds;
 
-  Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
+  Eigen::VectorXd k = SweepInitialization(&energy, options.sweep);
   if (warm_start != nullptr && warm_start->size() == k.size()) k = *warm_start;
   result.summary = Solve(&energy, options.solver, &k);
   result.k_solved = k;

@@ -8,10 +8,46 @@ namespace finecap {
 namespace {
 
 // Keeps the weighted mean defined where no image Gaussian is in reach (it then tends to the
-// surface Gaussian's own colour, a zero residual). Overlaps are of the order of sigma^2 ~ 1-100.
+// `fallback` colour). Overlaps are of the order of sigma^2 ~ 1-100.
 constexpr double kEmptyWeight = 1e-9;
 
+// The overlap-weighted mean of image Gaussians' colours, and its k-derivative.
+class ColorAccumulator {
+ public:
+  explicit ColorAccumulator(const Eigen::Vector3d& fallback)
+      : weighted_(kEmptyWeight * fallback) {}
+
+  void Add(OverlapForm form, const ProjectedGaussian& projected, const ImageGaussian& g,
+           bool with_derivative) {
+    double doverlap = 0.0;
+    const double overlap = GaussianOverlap(form, projected, Eigen::Vector2d(g.x, g.y), g.sigma,
+                                           with_derivative ? &doverlap : nullptr);
+    const Eigen::Vector3d color = g.Color().cast<double>();
+    weight_ += overlap;
+    weighted_ += overlap * color;
+    dweight_ += doverlap;
+    dweighted_ += doverlap * color;
+  }
+  Eigen::Vector3d Mean() const { return weighted_ / weight_; }
+  Eigen::Vector3d MeanDerivative() const { return (dweighted_ - Mean() * dweight_) / weight_; }
+
+ private:
+  double weight_ = kEmptyWeight;
+  double dweight_ = 0.0;
+  Eigen::Vector3d weighted_;
+  Eigen::Vector3d dweighted_ = Eigen::Vector3d::Zero();
+};
+
 }  // namespace
+
+Eigen::Vector3d ImageColorAround(const ImageGaussians& image, const ProjectedGaussian& projected,
+                                 OverlapForm form, double reach_sigmas) {
+  std::vector<int> ids;
+  image.FindReaching(projected.mean, projected.sigma, reach_sigmas, &ids);
+  ColorAccumulator accumulator(Eigen::Vector3d::Zero());
+  for (int i : ids) accumulator.Add(form, projected, image[i], false);
+  return accumulator.Mean();
+}
 
 SurfaceColorSimilarity::SurfaceColorSimilarity(const SurfaceGaussians& surface,
                                                const std::vector<EnergyView>& views,
@@ -44,22 +80,13 @@ void SurfaceColorSimilarity::Residual(int camera, int row, double k, Eigen::Vect
   const ProjectedGaussian projected = ProjectSurfaceGaussian(
       view.camera, surface_.base.col(s), surface_.normals.col(s), k, surface_.sigma_hat);
   const Eigen::Vector3d own = surface_.colors[s].cast<double>();
-  double weight = kEmptyWeight, dweight = 0.0;
-  Eigen::Vector3d weighted = kEmptyWeight * own, dweighted = Eigen::Vector3d::Zero();
+  ColorAccumulator accumulator(own);
   for (int p = pairs.begin[row]; p < pairs.begin[row + 1]; ++p) {
-    const ImageGaussian& g = (*view.image)[pairs.image_ids[p]];
-    double doverlap = 0.0;
-    const double overlap = GaussianOverlap(form_, projected, Eigen::Vector2d(g.x, g.y), g.sigma,
-                                           derivative ? &doverlap : nullptr);
-    const Eigen::Vector3d color = g.Color().cast<double>();
-    weight += overlap;
-    weighted += overlap * color;
-    dweight += doverlap;
-    dweighted += doverlap * color;
+    accumulator.Add(form_, projected, (*view.image)[pairs.image_ids[p]], derivative != nullptr);
   }
-  const Eigen::Vector3d predicted = weighted / weight;
+  const Eigen::Vector3d predicted = accumulator.Mean();
   *residual = scale_ * (predicted - own);
-  if (derivative != nullptr) *derivative = scale_ * (dweighted - predicted * dweight) / weight;
+  if (derivative != nullptr) *derivative = scale_ * accumulator.MeanDerivative();
 }
 
 double SurfaceColorSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {

@@ -7,6 +7,8 @@
 
 #include "finecap/atomic_file.h"
 #include "finecap/error.h"
+#include "finecap/surface_color_similarity.h"
+#include "finecap/surface_projection.h"
 
 namespace finecap {
 namespace {
@@ -55,6 +57,31 @@ bool GaussianWeightedMean(const cv::Mat& image, const Eigen::Vector2d& mean, dou
   return true;
 }
 
+// The paper's colouring skeleton: for each vertex the best-aligned camera that sees it, where
+// `sample(camera, vertex, projected, &colour)` reads the colour.
+template <typename Sample>
+ReferenceColors ColorFromBestCameras(const Eigen::Matrix3Xd& vertices,
+                                     const Eigen::Matrix3Xd& normals,
+                                     const std::vector<Camera>& cameras,
+                                     const std::vector<std::vector<unsigned char>>& visible,
+                                     ColorSpace color_space, double sigma_hat, const Sample& sample) {
+  ReferenceColors result;
+  result.color_space = color_space;
+  result.sigma_hat = sigma_hat;
+  const int n = static_cast<int>(vertices.cols());
+  result.colors.assign(n, Eigen::Vector3f::Zero());
+  result.valid.assign(n, 0);
+#pragma omp parallel for schedule(dynamic, 256)
+  for (int v = 0; v < n; ++v) {
+    const int c = BestAlignedCamera(vertices.col(v), normals.col(v), cameras, visible, v);
+    if (c < 0) continue;
+    const ProjectedGaussian projected =
+        ProjectSurfaceGaussian(cameras[c], vertices.col(v), normals.col(v), 0.0, sigma_hat);
+    result.valid[v] = sample(c, projected, &result.colors[v]);
+  }
+  return result;
+}
+
 }  // namespace
 
 ReferenceColors ComputeReferenceColors(const Eigen::Matrix3Xd& vertices,
@@ -67,23 +94,26 @@ ReferenceColors ComputeReferenceColors(const Eigen::Matrix3Xd& vertices,
   for (size_t c = 0; c < images.size(); ++c) {
     converted[c] = ConvertImage(images[c], color_space, cameras[c].name);
   }
-  ReferenceColors result;
-  result.color_space = color_space;
-  result.sigma_hat = sigma_hat;
-  const int n = static_cast<int>(vertices.cols());
-  result.colors.assign(n, Eigen::Vector3f::Zero());
-  result.valid.assign(n, 0);
-#pragma omp parallel for schedule(dynamic, 256)
-  for (int v = 0; v < n; ++v) {
-    const int c = BestAlignedCamera(vertices.col(v), normals.col(v), cameras, visible, v);
-    if (c < 0) continue;
-    const Camera& camera = cameras[c];
-    const double z = camera.Depth(vertices.col(v));
-    const double sigma = sigma_hat * camera.focal() / z;
-    result.valid[v] = GaussianWeightedMean(converted[c], camera.Project(vertices.col(v)), sigma,
-                                           &result.colors[v]);
-  }
-  return result;
+  return ColorFromBestCameras(
+      vertices, normals, cameras, visible, color_space, sigma_hat,
+      [&](int c, const ProjectedGaussian& projected, Eigen::Vector3f* color) {
+        return GaussianWeightedMean(converted[c], projected.mean, projected.sigma, color);
+      });
+}
+
+ReferenceColors ComputeModelReferenceColors(const Eigen::Matrix3Xd& vertices,
+                                            const Eigen::Matrix3Xd& normals,
+                                            const std::vector<Camera>& cameras,
+                                            const std::vector<ImageGaussians>& images,
+                                            const std::vector<std::vector<unsigned char>>& visible,
+                                            double sigma_hat, OverlapForm form,
+                                            double reach_sigmas) {
+  return ColorFromBestCameras(
+      vertices, normals, cameras, visible, images.front().color_space(), sigma_hat,
+      [&](int c, const ProjectedGaussian& projected, Eigen::Vector3f* color) {
+        *color = ImageColorAround(images[c], projected, form, reach_sigmas).cast<float>();
+        return true;
+      });
 }
 
 void WriteReferenceColors(const std::string& path, const ReferenceColors& colors) {

@@ -24,6 +24,7 @@
 #include "finecap/solver.h"
 #include "finecap/subdivision.h"
 #include "finecap/surface_gaussians.h"
+#include "finecap/sweep.h"
 #include "finecap/visibility.h"
 
 namespace finecap {
@@ -34,6 +35,11 @@ struct RefineOptions {
   int subdivision_levels = 1;
   // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007.
   double sigma_hat = 0.007;
+  // How the reference frame colours the surface Gaussians: "pixels" (the paper: the mean of the
+  // pixels under the projected Gaussian in the best-aligned camera) or "image_model" (in that
+  // camera, what the energy's image model shows there; see ComputeModelReferenceColors).
+  // Default "pixels".
+  std::string reference_colors = "pixels";
   // After solving, add sigma_hat along the normal to every refined vertex, compensating the
   // slight shrink the Gaussians' extent causes (the paper's section 6). Default true.
   bool bias_compensation = true;
@@ -43,6 +49,9 @@ struct RefineOptions {
   bool keep_input_if_worse = false;
   // Start each frame from the previous frame's k instead of from zero. Default false.
   bool warm_start = false;
+
+  // A plane-sweep search for each Gaussian's starting displacement (sweep.h); off by default.
+  SweepOptions sweep;
 
   ImageGaussianOptions image;
   VisibilityOptions visibility;

@@ -30,6 +30,11 @@
 
 namespace finecap {
 
+// p_sc for one projected surface Gaussian: the overlap-weighted mean colour of the image
+// Gaussians within `reach_sigmas` combined standard deviations (zero when there is none).
+Eigen::Vector3d ImageColorAround(const ImageGaussians& image, const ProjectedGaussian& projected,
+                                 OverlapForm form, double reach_sigmas);
+
 class SurfaceColorSimilarity : public SimilarityTerm {
  public:
   // `views` must have been built without colour weights (PairOptions::color_cutoff <= 0); both

@@ -12,6 +12,8 @@
 
 #include "finecap/camera.h"
 #include "finecap/color.h"
+#include "finecap/gaussian_overlap.h"
+#include "finecap/image_gaussians.h"
 
 namespace finecap {
 
@@ -47,6 +49,18 @@ ReferenceColors ComputeReferenceColors(const Eigen::Matrix3Xd& vertices,
                                        const std::vector<cv::Mat>& images,
                                        const std::vector<std::vector<unsigned char>>& visible,
                                        ColorSpace color_space, double sigma_hat);
+
+// The same choice of camera, but the colour is what the colour similarity's image model shows
+// there at k = 0: the overlap-weighted mean of the image Gaussians' colours
+// (surface_color_similarity.h), so that in the reference frame the colour residual of the best
+// camera is exactly zero and no blur difference between pixels and image model remains.
+ReferenceColors ComputeModelReferenceColors(const Eigen::Matrix3Xd& vertices,
+                                            const Eigen::Matrix3Xd& normals,
+                                            const std::vector<Camera>& cameras,
+                                            const std::vector<ImageGaussians>& images,
+                                            const std::vector<std::vector<unsigned char>>& visible,
+                                            double sigma_hat, OverlapForm form,
+                                            double reach_sigmas);
 
 // A text file, one vertex a line; the header states the colour space and sigma_hat. Written
 // atomically. Reading throws Error naming the file when it is malformed or was made for another

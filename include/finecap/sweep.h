@@ -1,0 +1,33 @@
+// A starting point for the solvers, found the way plane-sweep stereo finds depth: the data term
+// is evaluated for every surface Gaussian at a few displacements spanning [-k_max, k_max] (all
+// at once, since each evaluation moves every Gaussian by the same k), the per-Gaussian costs are
+// smoothed over the mesh's neighbours so that a single colour coincidence cannot win, and each
+// Gaussian starts at its best displacement. The local solvers then start inside the right basin
+// instead of at k = 0, where the nearest optimum of a textured surface is often a wrong one (the
+// paper's "risk of returning local maxima").
+#ifndef FINECAP_SWEEP_H_
+#define FINECAP_SWEEP_H_
+
+#include <Eigen/Core>
+
+#include "finecap/frame_energy.h"
+
+namespace finecap {
+
+struct SweepOptions {
+  // Number of displacements tried in [-k_max, k_max]; 0 turns the sweep off. Default 0.
+  int samples = 0;
+  // Rounds of averaging each Gaussian's cost curve with its neighbours'. Default 4.
+  int smoothing_rounds = 4;
+
+  void Check() const;
+};
+
+// The starting k (one entry per surface Gaussian, metres). The cost of a Gaussian at a
+// displacement is the sum of squares of the residual blocks it belongs to, shared equally
+// among the block's parameters.
+Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options);
+
+}  // namespace finecap
+
+#endif  // FINECAP_SWEEP_H_

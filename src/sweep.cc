@@ -1,0 +1,80 @@
+#include "finecap/sweep.h"
+
+#include <vector>
+
+#include "finecap/error.h"
+
+namespace finecap {
+
+void SweepOptions::Check() const {
+  Require(samples == 0 || samples >= 3, "solver.sweep_samples", "must be 0 (off) or at least 3");
+  Require(smoothing_rounds >= 0, "solver.sweep_smoothing_rounds", "must be non-negative");
+}
+
+namespace {
+
+// costs(s, j): the data cost of Gaussian s at displacement j.
+Eigen::MatrixXd SweepCosts(FrameEnergy* energy, const Eigen::VectorXd& displacements) {
+  SimilarityTerm& term = energy->similarity();
+  const int n = energy->num_parameters();
+  Eigen::MatrixXd costs = Eigen::MatrixXd::Zero(n, displacements.size());
+  const auto& blocks = term.residual_blocks();
+  std::vector<double> residuals;
+  for (int j = 0; j < displacements.size(); ++j) {
+    term.PrepareResiduals(Eigen::VectorXd::Constant(n, displacements[j]), false);
+    for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+      residuals.resize(blocks[b].num_residuals);
+      term.BlockResiduals(b, residuals.data(), nullptr);
+      double cost = 0.0;
+      for (double r : residuals) cost += r * r;
+      for (int s : blocks[b].parameters) costs(s, j) += cost / blocks[b].parameters.size();
+    }
+  }
+  return costs;
+}
+
+// Each round replaces a Gaussian's cost curve by the mean of its own and its neighbours'.
+void SmoothOverNeighbours(const Regularizer& regularizer, int rounds, Eigen::MatrixXd* costs) {
+  const int n = static_cast<int>(costs->rows());
+  for (int round = 0; round < rounds; ++round) {
+    Eigen::MatrixXd sum = *costs;
+    Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
+    for (const Regularizer::Pair& pair : regularizer.pairs()) {
+      if (pair.b < 0) continue;
+      sum.row(pair.a) += costs->row(pair.b);
+      sum.row(pair.b) += costs->row(pair.a);
+      count[pair.a] += 1.0;
+      count[pair.b] += 1.0;
+    }
+    *costs = sum.array().colwise() / count.array();
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options) {
+  options.Check();
+  const int n = energy->num_parameters();
+  if (options.samples == 0) return Eigen::VectorXd::Zero(n);
+  const double k_max = energy->options().k_max;
+  const Eigen::VectorXd displacements =
+      Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
+  Eigen::MatrixXd costs = SweepCosts(energy, displacements);
+  SmoothOverNeighbours(energy->regularizer(), options.smoothing_rounds, &costs);
+  const double step = displacements[1] - displacements[0];
+  Eigen::VectorXd k(n);
+  for (int s = 0; s < n; ++s) {
+    int best = 0;
+    costs.row(s).minCoeff(&best);
+    k[s] = displacements[best];
+    // Sub-sample position: the vertex of the parabola through the best sample and its neighbours.
+    if (best > 0 && best + 1 < displacements.size()) {
+      const double c0 = costs(s, best - 1), c1 = costs(s, best), c2 = costs(s, best + 1);
+      const double curvature = c0 - 2.0 * c1 + c2;
+      if (curvature > 0.0) k[s] += 0.5 * step * (c0 - c2) / curvature;
+    }
+  }
+  return k;
+}
+
+}  // namespace finecap
