@@ -16,6 +16,9 @@ constexpr float kInv255 = 1.0f / 255.0f;
 // Radius of the HSV cone's base: makes the chroma plane span [-0.5, 0.5]^2.
 constexpr double kHsvChromaRadius = 0.5;
 constexpr double kLabScale = 0.01;
+// Added to R + G + B (8-bit units) before dividing: dark pixels, whose chromaticity is mostly
+// noise, fade towards black (0, 0, 0) instead of jumping around.
+constexpr float kChromaticityDarkLevel = 3.0f * 0.05f * 255.0f;
 
 // The chroma-plane point (0.5 * C * cos, 0.5 * C * sin) of a hue 60 * d / C degrees from its
 // sector's base, for every 8-bit chroma C in [1, 255] and 0 <= d <= C. HSV's hue is the rational
@@ -91,6 +94,20 @@ cv::Mat ConvertToNormalizedRgb(const cv::Mat& bgr) {
   return out;
 }
 
+cv::Mat ConvertToChromaticity(const cv::Mat& bgr) {
+  cv::Mat out(bgr.size(), CV_32FC3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* in_row = bgr.ptr<cv::Vec3b>(y);
+    cv::Vec3f* out_row = out.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const float b = in_row[x][0], g = in_row[x][1], r = in_row[x][2];
+      const float scale = 1.0f / (r + g + b + kChromaticityDarkLevel);
+      out_row[x] = cv::Vec3f(r * scale, g * scale, b * scale);
+    }
+  }
+  return out;
+}
+
 cv::Mat ConvertToLab(const cv::Mat& bgr) {
   // OpenCV's 8-bit Lab output is quantised to bytes; its float path keeps full precision.
   cv::Mat unit_bgr, lab;
@@ -108,6 +125,8 @@ cv::Mat ConvertUnchecked(const cv::Mat& bgr, ColorSpace space) {
       return ConvertToNormalizedRgb(bgr);
     case ColorSpace::kLab:
       return ConvertToLab(bgr);
+    case ColorSpace::kChromaticity:
+      return ConvertToChromaticity(bgr);
   }
   throw Error("", "unknown colour space");
 }
@@ -122,15 +141,19 @@ std::string ColorSpaceName(ColorSpace space) {
       return "normalized_rgb";
     case ColorSpace::kLab:
       return "lab";
+    case ColorSpace::kChromaticity:
+      return "chromaticity";
   }
   throw Error("", "unknown colour space");
 }
 
 ColorSpace ParseColorSpace(const std::string& name, const std::string& where) {
-  for (ColorSpace space : {ColorSpace::kHsv, ColorSpace::kNormalizedRgb, ColorSpace::kLab}) {
+  for (ColorSpace space : {ColorSpace::kHsv, ColorSpace::kNormalizedRgb, ColorSpace::kLab,
+                           ColorSpace::kChromaticity}) {
     if (name == ColorSpaceName(space)) return space;
   }
-  throw Error(where, "unknown colour space '" + name + "'; expected hsv, normalized_rgb or lab");
+  throw Error(where, "unknown colour space '" + name +
+                         "'; expected hsv, normalized_rgb, lab or chromaticity");
 }
 
 Eigen::Vector3f ConvertColor(const cv::Vec3b& bgr, ColorSpace space) {

@@ -40,10 +40,10 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                   "Add sigma_hat along the normal after solving (the paper's shrink "
                   "compensation).");
   schema->AddCustom(
-      "image_gaussians.color_space", "choice", "hsv, normalized_rgb, lab",
+      "image_gaussians.color_space", "choice", "hsv, normalized_rgb, lab, chromaticity",
       "Colour space in which colours are averaged and compared (paper: hsv).",
       [&refine](const YAML::Node& value, const std::string& where) {
-        Require(value.IsScalar(), where, "expected one of: hsv, normalized_rgb, lab");
+        Require(value.IsScalar(), where, "expected one of: hsv, normalized_rgb, lab, chromaticity");
         refine.image.color_space = ParseColorSpace(value.Scalar(), where);
       },
       [&refine] { return ColorSpaceName(refine.image.color_space); });

@@ -14,8 +14,7 @@ constexpr double kEmptyWeight = 1e-9;
 // The overlap-weighted mean of image Gaussians' colours, and its k-derivative.
 class ColorAccumulator {
  public:
-  explicit ColorAccumulator(const Eigen::Vector3d& fallback)
-      : weighted_(kEmptyWeight * fallback) {}
+  explicit ColorAccumulator(const Eigen::Vector3d& fallback) : weighted_(kEmptyWeight * fallback) {}
 
   void Add(OverlapForm form, const ProjectedGaussian& projected, const ImageGaussian& g,
            bool with_derivative) {

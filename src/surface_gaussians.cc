@@ -64,7 +64,8 @@ ReferenceColors ColorFromBestCameras(const Eigen::Matrix3Xd& vertices,
                                      const Eigen::Matrix3Xd& normals,
                                      const std::vector<Camera>& cameras,
                                      const std::vector<std::vector<unsigned char>>& visible,
-                                     ColorSpace color_space, double sigma_hat, const Sample& sample) {
+                                     ColorSpace color_space, double sigma_hat,
+                                     const Sample& sample) {
   ReferenceColors result;
   result.color_space = color_space;
   result.sigma_hat = sigma_hat;

@@ -57,8 +57,7 @@ Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& opt
   const int n = energy->num_parameters();
   if (options.samples == 0) return Eigen::VectorXd::Zero(n);
   const double k_max = energy->options().k_max;
-  const Eigen::VectorXd displacements =
-      Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
+  const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
   Eigen::MatrixXd costs = SweepCosts(energy, displacements);
   SmoothOverNeighbours(energy->regularizer(), options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];

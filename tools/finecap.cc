@@ -41,8 +41,10 @@ struct Subcommand {
 
 const std::vector<Subcommand>& Subcommands() {
   static const std::vector<Subcommand> kSubcommands = {
-      {"synth", "Generate a synthetic capture with ground truth (cameras, images, meshes, gt/).",
-       "finecap synth --config configs/synth_demo.yaml --out data/demo", &RunSynth,
+      {"synth",
+       "Generate a synthetic capture with ground truth (cameras, images, meshes, gt/).",
+       "finecap synth --config configs/synth_demo.yaml --out data/demo",
+       &RunSynth,
        {"config", "out", "set"}},
       {"probe",
        "Diagnostic: the configured energy along k = alpha * k_true on a frame with ground truth; "

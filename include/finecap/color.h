@@ -20,6 +20,11 @@
 // * kLab ("lab"): CIE L*a*b* (sRGB input, D65 white, as OpenCV's COLOR_BGR2Lab) divided by 100:
 //   L in [0, 1], a and b in about [-1, 1]. One uniform scale keeps Lab's perceptual distance, so
 //   a distance of 0.05 is Delta E (CIE76) = 5.
+// * kChromaticity ("chromaticity"): (R, G, B) / (R + G + B + 38), each in [0, 1]: the colour
+//   without its brightness, so that shading (a fold turned away from the light is darker, the
+//   same cloth under a changed light) does not count as a colour difference. The constant 38
+//   (3 x 5 % of 255) makes dark pixels, whose chromaticity is mostly noise, fade towards black.
+//   A texture that varies only in brightness (grey print) looks uniform in this space.
 //
 // Averaging. A mean colour is the mean of the embedded coordinates (convert first, then average).
 // That mean minimises the sum of squared colour distances to the pixels, so averaging agrees with
@@ -36,9 +41,9 @@
 
 namespace finecap {
 
-enum class ColorSpace { kHsv, kNormalizedRgb, kLab };
+enum class ColorSpace { kHsv, kNormalizedRgb, kLab, kChromaticity };
 
-// The name used in config files: "hsv", "normalized_rgb" or "lab".
+// The name used in config files: "hsv", "normalized_rgb", "lab" or "chromaticity".
 std::string ColorSpaceName(ColorSpace space);
 
 // Inverse of ColorSpaceName (exact, lower case). Throws Error(where, ...) listing the valid names

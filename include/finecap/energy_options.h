@@ -13,7 +13,8 @@ struct EnergyOptions {
   //                   projection, the overlap-weighted mean of the image Gaussians' colours (a
   //                   closed-form least-squares residual per surface Gaussian and camera; see
   //                   the README for why it peaks at the true surface where the paper's does not).
-  std::string similarity = "paper";
+  // Default "surface_color" (measured with `finecap probe` and `finecap refine`, see the README).
+  std::string similarity = "surface_color";
   // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
   // (the true integral, half the exponent). See gaussian_overlap.h.
   std::string overlap = "printed";
@@ -25,8 +26,10 @@ struct EnergyOptions {
   double reach_sigmas = 3.0;
   // Bound on the displacement |k| along the normal, metres. Default 0.02.
   double k_max = 0.02;
-  // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg).
-  double w_reg = 1.0;
+  // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg, and its
+  // E_sim). Default 1e-7, for the surface-colour similarity, whose residuals are colour
+  // differences (~0.01) where the paper's E_sim counts image patches (~1e4).
+  double w_reg = 1e-7;
   // Neighbourhood size Delta of the regulariser, edges; also the Wendland cut-off of its weights
   // T(delta_sj). Paper: 2.
   int reg_rings = 2;

@@ -20,8 +20,8 @@ struct FrameStats {
   int iterations = 0;
   int evaluations = 0;
   std::string termination;
-  double seconds = 0.0;                // The whole frame, reading and writing included.
-  double seconds_preparation = 0.0;    // Subdivision, visibility, image Gaussians, pairs.
+  double seconds = 0.0;              // The whole frame, reading and writing included.
+  double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pairs.
   double seconds_solve = 0.0;
   double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
   double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.

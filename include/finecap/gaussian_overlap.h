@@ -39,7 +39,9 @@ struct ProjectedGaussian {
 };
 
 // 1 for the printed form's exponent -|d|^2/S, 2 for the exact -|d|^2/(2S).
-inline double ExponentDivisor(OverlapForm form) { return form == OverlapForm::kPrinted ? 1.0 : 2.0; }
+inline double ExponentDivisor(OverlapForm form) {
+  return form == OverlapForm::kPrinted ? 1.0 : 2.0;
+}
 
 // The weight of sigma_i^2 in S.
 inline double ImageVarianceFactor(OverlapForm form) {

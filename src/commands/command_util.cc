@@ -98,8 +98,8 @@ void Progress::FrameDone(const std::string& name, bool skipped, const std::strin
   last_ = now;
   const double per_frame = timed_ > 0 ? seconds_ / timed_ : 0.0;
   char line[256];
-  std::snprintf(line, sizeof(line), "frame %d/%d (%s) %s| %.1f s/frame, %.0f s left", done_,
-                total_, name.c_str(), skipped ? "already done " : "", per_frame,
+  std::snprintf(line, sizeof(line), "frame %d/%d (%s) %s| %.1f s/frame, %.0f s left", done_, total_,
+                name.c_str(), skipped ? "already done " : "", per_frame,
                 per_frame * (total_ - done_));
   if (terminal_) {
     std::cerr << "\r\033[K" << line << (done_ == total_ ? "\n" : "") << std::flush;

@@ -46,8 +46,8 @@ int RunProbe(const Config& config, int frame_index) {
               capture.frame_name(frame) + ".ply): the probe needs a synthetic capture");
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
-  const std::string out = config.output.dir.empty() ? std::string(".")
-                                                     : internal::PrepareOutputFolder(config, capture);
+  const std::string out =
+      config.output.dir.empty() ? std::string(".") : internal::PrepareOutputFolder(config, capture);
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
   const FrameInput input = internal::ReadFrameInput(&capture, frame);
@@ -59,21 +59,22 @@ int RunProbe(const Config& config, int frame_index) {
   Eigen::VectorXd truth(energy.num_parameters());
   for (int s = 0; s < truth.size(); ++s) {
     const double k = truth_all[energy.surface().vertex_ids[s]];
-    truth[s] = std::isfinite(k) ? std::clamp(k, -energy.options().k_max, energy.options().k_max)
-                                : 0.0;
+    truth[s] =
+        std::isfinite(k) ? std::clamp(k, -energy.options().k_max, energy.options().k_max) : 0.0;
   }
-  std::printf("probe: frame %s, similarity %s (%s overlap), %d surface Gaussians, %ld pairs, "
-              "RMS of k_true %.2f mm\n",
-              capture.frame_name(frame).c_str(), energy.options().similarity.c_str(),
-              energy.options().overlap.c_str(), energy.num_parameters(), energy.num_pairs(),
-              1000.0 * std::sqrt(truth.squaredNorm() / std::max<long>(truth.size(), 1)));
+  std::printf(
+      "probe: frame %s, similarity %s (%s overlap), %d surface Gaussians, %ld pairs, "
+      "RMS of k_true %.2f mm\n",
+      capture.frame_name(frame).c_str(), energy.options().similarity.c_str(),
+      energy.options().overlap.c_str(), energy.num_parameters(), energy.num_pairs(),
+      1000.0 * std::sqrt(truth.squaredNorm() / std::max<long>(truth.size(), 1)));
   std::printf("%8s %16s %16s %16s\n", "alpha", "E", "E_sim", "E_reg");
   std::vector<ProbeSample> samples;
   for (int step = -5; step <= 15; ++step) {
     ProbeSample sample;
     sample.alpha = 0.1 * step;
-    sample.energy = energy.Evaluate(sample.alpha * truth, nullptr, &sample.similarity,
-                                    &sample.regularization);
+    sample.energy =
+        energy.Evaluate(sample.alpha * truth, nullptr, &sample.similarity, &sample.regularization);
     std::printf("%8.2f %16.8g %16.8g %16.8g\n", sample.alpha, sample.energy, sample.similarity,
                 sample.regularization);
     samples.push_back(sample);
@@ -82,7 +83,8 @@ int RunProbe(const Config& config, int frame_index) {
   PlotSeries similarity{"E_sim (normalised)", {}, {}}, total{"E (normalised)", {}, {}};
   const auto normalise = [&](double ProbeSample::*value, PlotSeries* series) {
     double low = samples[0].*value, high = low;
-    for (const ProbeSample& s : samples) low = std::min(low, s.*value), high = std::max(high, s.*value);
+    for (const ProbeSample& s : samples)
+      low = std::min(low, s.*value), high = std::max(high, s.*value);
     for (const ProbeSample& s : samples) {
       series->x.push_back(s.alpha);
       series->y.push_back(high > low ? (s.*value - low) / (high - low) : 0.0);

@@ -9,8 +9,8 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
-#include "finecap/metrics.h"
 #include "finecap/mesh_io.h"
+#include "finecap/metrics.h"
 
 namespace finecap {
 namespace {
@@ -23,8 +23,8 @@ struct FramePaths {
 };
 
 FramePaths OutputPaths(const std::string& out, const std::string& frame, const Config& config) {
-  return {out + "/meshes/" + frame + "." + config.output.mesh_format,
-          out + "/k/" + frame + ".txt", out + "/frames/" + frame + ".json"};
+  return {out + "/meshes/" + frame + "." + config.output.mesh_format, out + "/k/" + frame + ".txt",
+          out + "/frames/" + frame + ".json"};
 }
 
 void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k) {
@@ -130,11 +130,10 @@ int RunRefine(const Config& config) {
 
     std::ostringstream detail;
     detail.precision(3);
-    detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", "
-           << stats.iterations << " iterations" << (stats.worse ? ", WORSE" : "");
+    detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
+           << " iterations" << (stats.worse ? ", WORSE" : "");
     if (std::isfinite(stats.rms_refined_mm)) {
-      detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm
-             << " mm";
+      detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
       sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
       sum_refined2 += stats.rms_refined_mm * stats.rms_refined_mm;
       ++measured;
