@@ -1,0 +1,89 @@
+// The command line as a user meets it: subcommands listed, bad input refused with one message
+// naming the file and the problem, a non-zero exit, and no output written.
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together.
+};
+
+RunResult RunFinecap(const std::string& arguments) {
+  RunResult result;
+  const std::string command = std::string(FINECAP_BINARY) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer;
+  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+fs::path FreshFolder(const std::string& name) {
+  const fs::path folder = fs::path(::testing::TempDir()) / ("cli_" + name);
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+TEST(CliTest, HelpListsTheSubcommands) {
+  const RunResult result = RunFinecap("--help");
+  EXPECT_EQ(result.exit_code, 0);
+  for (const char* subcommand : {"synth", "refine", "probe"}) {
+    EXPECT_NE(result.output.find(std::string("  ") + subcommand + "\n"), std::string::npos)
+        << subcommand;
+  }
+  EXPECT_NE(result.output.find("energy.similarity"), std::string::npos);
+}
+
+TEST(CliTest, MissingCaptureFolderIsNamedAndNothingIsWritten) {
+  const fs::path folder = FreshFolder("missing");
+  const fs::path out = folder / "out";
+  const RunResult result =
+      RunFinecap("refine --capture " + (folder / "nowhere").string() + " --out " + out.string());
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find((folder / "nowhere").string()), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(CliTest, MalformedCamerasYamlIsNamed) {
+  const fs::path capture = FreshFolder("malformed");
+  fs::create_directories(capture / "meshes");
+  std::ofstream(capture / "cameras.yaml") << "cameras: [ {name: cam0, width: 10\n";
+  const RunResult result = RunFinecap("refine --capture " + capture.string() + " --out " +
+                                      (capture / ".." / "out_m").string());
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("cameras.yaml"), std::string::npos) << result.output;
+  EXPECT_FALSE(fs::exists(capture / ".." / "out_m"));
+}
+
+TEST(CliTest, UnknownConfigKeyNamesFileAndKey) {
+  const fs::path folder = FreshFolder("config");
+  const fs::path config = folder / "bad.yaml";
+  std::ofstream(config) << "energy:\n  simlarity: paper\n";
+  const RunResult result = RunFinecap("refine --config " + config.string());
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("bad.yaml: key 'energy.simlarity': unknown key"), std::string::npos)
+      << result.output;
+}
+
+TEST(CliTest, UnknownSubcommandAndBadOverrideAreRefused) {
+  EXPECT_EQ(RunFinecap("refin").exit_code, 2);
+  const RunResult result = RunFinecap("refine --set solver.max_iterations=many");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.output.find("solver.max_iterations"), std::string::npos) << result.output;
+}
+
+}  // namespace
