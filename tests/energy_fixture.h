@@ -14,14 +14,14 @@
 
 namespace finecap {
 
-// A rows x cols grid mesh in the plane z = 0 (spacing in metres), curved a little in z.
-inline Mesh GridMesh(int rows, int cols, double spacing) {
+// A rows x cols grid mesh around the origin (spacing in metres), z = curvature/2 (x^2 + y^2).
+inline Mesh GridMesh(int rows, int cols, double spacing, double curvature = 1.0) {
   Mesh mesh;
   mesh.vertices.resize(3, rows * cols);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       const double x = (c - 0.5 * (cols - 1)) * spacing, y = (r - 0.5 * (rows - 1)) * spacing;
-      mesh.vertices.col(r * cols + c) = Eigen::Vector3d(x, y, 0.5 * (x * x + y * y));
+      mesh.vertices.col(r * cols + c) = Eigen::Vector3d(x, y, 0.5 * curvature * (x * x + y * y));
     }
   }
   mesh.faces.resize(3, 2 * (rows - 1) * (cols - 1));

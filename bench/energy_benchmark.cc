@@ -1,0 +1,100 @@
+// One evaluation of the energy and its gradient on a synth_skirt frame (10k surface Gaussians,
+// 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads; and the
+// preparation of a frame (subdivision, visibility, image Gaussians, pair lists).
+//
+//   build/energy_benchmark [--benchmark_repetitions=5]
+//
+// The capture is generated once into a temporary folder (about ten seconds).
+#include <omp.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+
+#include "finecap/capture.h"
+#include "finecap/config.h"
+#include "finecap/refine.h"
+
+namespace finecap {
+namespace {
+
+struct SkirtFrame {
+  std::unique_ptr<SequenceModel> model;
+  ReferenceColors colors;
+  FrameInput input;
+};
+
+FrameInput ReadFrame(Capture* capture, int frame) {
+  FrameInput input;
+  input.coarse = capture->ReadCoarseMesh(frame);
+  input.cameras = capture->cameras();
+  for (int c = 0; c < capture->num_cameras(); ++c)
+    input.images.push_back(capture->ReadImage(c, frame));
+  return input;
+}
+
+// Frame 3 of synth_skirt (its folds fully grown), colours from frame 0.
+const SkirtFrame& Skirt() {
+  static const SkirtFrame* frame = [] {
+    Config config = LoadConfig(FINECAP_SOURCE_DIR "/configs/synth_skirt.yaml",
+                               {{"synth.num_frames", "4", "benchmark"}});
+    const std::string dir = (std::filesystem::temp_directory_path() /
+                             ("finecap_bench_skirt_" + std::to_string(getpid())))
+                                .string();
+    GenerateSyntheticCapture(config.synth, dir);
+    Capture capture = Capture::Open(dir);
+    auto* skirt = new SkirtFrame;
+    skirt->model = std::make_unique<SequenceModel>(capture.ReadCoarseMesh(0), capture.vertex_mask(),
+                                                   config.refine, dir);
+    skirt->colors = ComputeSequenceColors(*skirt->model, ReadFrame(&capture, 0), config.refine);
+    skirt->input = ReadFrame(&capture, 3);
+    std::filesystem::remove_all(dir);
+    return skirt;
+  }();
+  return *frame;
+}
+
+RefineOptions Options(const std::string& similarity) {
+  RefineOptions options;
+  options.energy.similarity = similarity;
+  return options;
+}
+
+void BM_EnergyAndGradient(benchmark::State& state, const std::string& similarity) {
+  const SkirtFrame& skirt = Skirt();
+  const int threads = state.range(0) > 0 ? static_cast<int>(state.range(0)) : omp_get_num_procs();
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, Options(similarity));
+  const Eigen::VectorXd k = Eigen::VectorXd::Constant(frame.energy->num_parameters(), 0.001);
+  Eigen::VectorXd gradient;
+  omp_set_num_threads(threads);
+  for (auto _ : state) benchmark::DoNotOptimize(frame.energy->Evaluate(k, &gradient));
+  omp_set_num_threads(omp_get_num_procs());
+  state.counters["threads"] = threads;
+  state.counters["surface_gaussians"] = frame.energy->num_parameters();
+  state.counters["pairs"] = static_cast<double>(frame.energy->num_pairs());
+}
+BENCHMARK_CAPTURE(BM_EnergyAndGradient, surface_color, std::string("surface_color"))
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_EnergyAndGradient, paper, std::string("paper"))
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond);
+
+void BM_PrepareFrame(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const RefineOptions options;
+  for (auto _ : state) {
+    PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+    benchmark::DoNotOptimize(frame.energy.get());
+  }
+}
+BENCHMARK(BM_PrepareFrame)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace finecap
+
+BENCHMARK_MAIN();
