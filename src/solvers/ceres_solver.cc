@@ -57,22 +57,6 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
   return ceres_options;
 }
 
-class TraceRecorder : public ceres::IterationCallback {
- public:
-  TraceRecorder(const Stopwatch& clock, SolverSummary* summary)
-      : clock_(clock), summary_(summary) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
-    // Ceres minimises the least-squares cost; the trace records it negated, so that for the
-    // colour similarity it is E itself and for every form larger is better.
-    summary_->trace.push_back({iteration.iteration, -iteration.cost, clock_.Seconds()});
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const Stopwatch& clock_;
-  SolverSummary* summary_;
-};
-
 }  // namespace
 
 void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,

@@ -47,20 +47,6 @@ class NegativeEnergy : public ceres::FirstOrderFunction {
   int* evaluations_;
 };
 
-class TraceRecorder : public ceres::IterationCallback {
- public:
-  TraceRecorder(const Stopwatch& clock, SolverSummary* summary)
-      : clock_(clock), summary_(summary) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
-    summary_->trace.push_back({iteration.iteration, -iteration.cost, clock_.Seconds()});
-    return ceres::SOLVER_CONTINUE;
-  }
-
- private:
-  const Stopwatch& clock_;
-  SolverSummary* summary_;
-};
-
 }  // namespace
 
 void SolveWithLbfgs(const FrameEnergy& energy, const SolverOptions& options, Eigen::VectorXd* k,

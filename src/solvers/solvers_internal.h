@@ -5,6 +5,8 @@
 
 #include <chrono>
 
+#include <ceres/iteration_callback.h>
+
 #include "finecap/solver.h"
 
 namespace finecap {
@@ -26,6 +28,23 @@ class Stopwatch {
 
  private:
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// Records each Ceres iteration in the summary's trace. Ceres minimises a cost; the trace holds it
+// negated, so that larger is better in every trace (for the colour similarity the least-squares
+// cost is exactly -E, and L-BFGS minimises -E itself).
+class TraceRecorder : public ceres::IterationCallback {
+ public:
+  TraceRecorder(const Stopwatch& clock, SolverSummary* summary)
+      : clock_(clock), summary_(summary) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
+    summary_->trace.push_back({iteration.iteration, -iteration.cost, clock_.Seconds()});
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const Stopwatch& clock_;
+  SolverSummary* summary_;
 };
 
 }  // namespace internal
