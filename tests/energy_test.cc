@@ -6,6 +6,7 @@
 #include "finecap/frame_energy.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
+#include "finecap/surface_projection.h"
 
 namespace finecap {
 namespace {
@@ -168,6 +169,88 @@ TEST(RegularizerTest, MatchesThePapersDoubleSumAndItsGradient) {
   const Eigen::VectorXd numeric = NumericGradient(
       [&](const Eigen::VectorXd& x) { return regularizer.Evaluate(x, nullptr); }, k, 1e-7);
   EXPECT_LT((analytic - numeric).norm(), 1e-6 * numeric.norm());
+}
+
+}  // namespace
+}  // namespace finecap
+
+namespace finecap {
+namespace {
+
+// One image Gaussian exactly as wide as the projected surface Gaussians: a single pair explains
+// it almost fully (sum just below E_ii, the clamp not yet active) and two pairs more than fully
+// (clamped: no derivative may pass).
+class PaperClampTest : public ::testing::Test {
+ protected:
+  PaperClampTest() {
+    camera_ = LookAtOrigin(1.0, 0.0, 500.0, 200);
+    mesh_ = GridMesh(2, 2, 0.01, 0.0);
+    normals_ = ComputeVertexNormals(mesh_);
+    ReferenceColors colors;
+    colors.color_space = ColorSpace::kNormalizedRgb;
+    colors.sigma_hat = 0.004;
+    colors.colors.assign(4, Eigen::Vector3f(0.5f, 0.4f, 0.3f));
+    colors.valid.assign(4, 1);
+    surface_all_ = MakeSurfaceGaussians(mesh_.vertices, normals_, {0, 1, 2, 3}, colors);
+    const ProjectedGaussian projected = ProjectSurfaceGaussian(
+        camera_, surface_all_.base.col(0), surface_all_.normals.col(0), 0.0, 0.004);
+    ImageGaussian g;
+    g.x = static_cast<float>(projected.mean.x() + 0.3);
+    g.y = static_cast<float>(projected.mean.y());
+    g.sigma = static_cast<float>(projected.sigma);
+    g.color[0] = 0.5f, g.color[1] = 0.4f, g.color[2] = 0.3f;
+    image_ = std::make_unique<ImageGaussians>(200, 200, ColorSpace::kNormalizedRgb,
+                                              std::vector<ImageGaussian>{g}, "test");
+  }
+
+  // The paper's similarity and its analytic and numeric gradients, with surface Gaussians `ids`.
+  double Check(const std::vector<int>& ids, double* worst_error, double* gradient_norm) {
+    ReferenceColors colors;
+    colors.color_space = ColorSpace::kNormalizedRgb;
+    colors.sigma_hat = 0.004;
+    colors.colors.assign(4, Eigen::Vector3f(0.5f, 0.4f, 0.3f));
+    colors.valid.assign(4, 1);
+    const SurfaceGaussians surface = MakeSurfaceGaussians(mesh_.vertices, normals_, ids, colors);
+    std::vector<EnergyView> views(1);
+    views[0].camera = camera_;
+    views[0].image = image_.get();
+    PairOptions pair_options;
+    pair_options.k_max = 0.005;
+    views[0].pairs = BuildCameraPairs(camera_, *image_, surface,
+                                      std::vector<unsigned char>(surface.size(), 1), pair_options);
+    const PaperSimilarity similarity(surface, views, OverlapForm::kPrinted);
+    const Eigen::VectorXd k = Eigen::VectorXd::Zero(surface.size());
+    Eigen::VectorXd analytic;
+    const double value = similarity.Evaluate(k, &analytic);
+    const Eigen::VectorXd numeric = NumericGradient(
+        [&](const Eigen::VectorXd& x) { return similarity.Evaluate(x, nullptr); }, k, 1e-9);
+    *worst_error = (analytic - numeric).cwiseAbs().maxCoeff();
+    *gradient_norm = analytic.norm();
+    return value;
+  }
+
+  Camera camera_;
+  Mesh mesh_;
+  Eigen::Matrix3Xd normals_;
+  SurfaceGaussians surface_all_;
+  std::unique_ptr<ImageGaussians> image_;
+};
+
+TEST_F(PaperClampTest, JustBelowTheClampTheGradientMatches) {
+  double error = 0.0, norm = 0.0;
+  const double explained = Check({0}, &error, &norm);
+  EXPECT_GT(explained, 0.95);  // sum / E_ii: just below the clamp at 1.
+  EXPECT_LT(explained, 1.0);
+  EXPECT_GT(norm, 0.0);
+  EXPECT_LT(error, 1e-6 * norm);
+}
+
+TEST_F(PaperClampTest, AboveTheClampNoDerivativePasses) {
+  double error = 0.0, norm = 0.0;
+  const double explained = Check({0, 1, 2, 3}, &error, &norm);
+  EXPECT_DOUBLE_EQ(explained, 1.0);
+  EXPECT_EQ(norm, 0.0);
+  EXPECT_LT(error, 1e-9);
 }
 
 }  // namespace
