@@ -87,6 +87,10 @@ void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
                     "Bound on the displacement along the normal, m.", 1e-5, 1.0);
   schema->AddDouble("energy.w_reg", &energy->w_reg, "Weight of the regulariser (paper: 1).", 0.0,
                     1e12);
+  schema->AddDouble("energy.w_prior", &energy->w_prior,
+                    "Weight of a pull of k towards the input surface (not in the paper); keeps "
+                    "textureless regions in place.",
+                    0.0, 1e12);
   schema->AddInt("energy.reg_rings", &energy->reg_rings,
                  "Regulariser neighbourhood Delta in edges, also its Wendland cut-off (paper: 2).",
                  1, 10);

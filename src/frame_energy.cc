@@ -14,6 +14,7 @@ void EnergyOptions::Check() const {
   Require(reach_sigmas > 0.0, "energy.reach_sigmas", "must be positive");
   Require(k_max > 0.0, "energy.k_max", "must be positive");
   Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
+  Require(w_prior >= 0.0, "energy.w_prior", "must be non-negative");
   Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
   Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
 }
@@ -76,11 +77,14 @@ double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient
   Eigen::VectorXd similarity_gradient, regularization_gradient;
   const double e_sim = similarity_->Evaluate(k, gradient ? &similarity_gradient : nullptr);
   const double e_reg = regularizer_.Evaluate(k, gradient ? &regularization_gradient : nullptr);
-  if (gradient != nullptr)
-    *gradient = similarity_gradient - options_.w_reg * regularization_gradient;
+  const double u2 = options_.RegUnitScale() * options_.RegUnitScale();
+  if (gradient != nullptr) {
+    *gradient = similarity_gradient - options_.w_reg * regularization_gradient -
+                2.0 * options_.w_prior * u2 * k;
+  }
   if (similarity != nullptr) *similarity = e_sim;
   if (regularization != nullptr) *regularization = e_reg;
-  return e_sim - options_.w_reg * e_reg;
+  return e_sim - options_.w_reg * e_reg - options_.w_prior * u2 * k.squaredNorm();
 }
 
 }  // namespace finecap

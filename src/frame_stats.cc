@@ -58,6 +58,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.worse = result.worse;
   stats.kept_input = result.kept_input;
   stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
+  stats.rms_textureless_coarse_mm = stats.rms_textureless_refined_mm = std::nan("");
   return stats;
 }
 
@@ -81,7 +82,9 @@ std::string ToJson(const FrameStats& s) {
        << ", \"worse\": " << (s.worse ? "true" : "false")
        << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
-       << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm) << "}";
+       << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
+       << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
+       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm) << "}";
   return json.str();
 }
 

@@ -30,6 +30,11 @@ struct EnergyOptions {
   // E_sim). Default 1e-7, for the surface-colour similarity, whose residuals are colour
   // differences (~0.01) where the paper's E_sim counts image patches (~1e4).
   double w_reg = 1e-7;
+  // Weight w_prior of a pull of every k_s towards 0 (the input surface), E_prior = sum (u k_s)^2,
+  // E = E_sim - w_reg E_reg - w_prior E_prior. Where the images say nothing about k (a plain,
+  // textureless cloth) it keeps the input; where they do, the data outweighs it. Not in the
+  // paper. Default 0.
+  double w_prior = 0.0;
   // Neighbourhood size Delta of the regulariser, edges; also the Wendland cut-off of its weights
   // T(delta_sj). Paper: 2.
   int reg_rings = 2;

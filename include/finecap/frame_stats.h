@@ -34,6 +34,9 @@ struct FrameStats {
   // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
   double rms_coarse_mm = 0.0;
   double rms_refined_mm = 0.0;
+  // The same over the textureless region (NaN when the capture marks none).
+  double rms_textureless_coarse_mm = 0.0;
+  double rms_textureless_refined_mm = 0.0;
 };
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,

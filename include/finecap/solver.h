@@ -27,8 +27,9 @@ struct SolverOptions {
   std::string type = "ceres";
   // Most iterations. Paper (gradient ascent): 150.
   int max_iterations = 50;
-  // Stop when the energy changes by less than this fraction of its value. Default 1e-6.
-  double function_tolerance = 1e-6;
+  // Stop when the energy changes by less than this fraction of its value. Default 1e-3: on
+  // synth_skirt, Ceres reaches within 0.01 mm of its 1e-6 result in 5 iterations instead of 32.
+  double function_tolerance = 1e-3;
   // Threads of Ceres' evaluation and linear algebra; 0 = all cores.
   int num_threads = 0;
 

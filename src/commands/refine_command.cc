@@ -47,26 +47,34 @@ void WriteStatsLines(const std::string& out, const Capture& capture, const Confi
   WriteTextFileAtomically(out + "/stats.jsonl", lines);
 }
 
-// The textured refined vertices: those outside the capture's textureless region.
-std::vector<int> TexturedVertices(const SequenceModel& model, const Capture& capture) {
+// The refined vertices outside and inside the capture's textureless region.
+struct Regions {
+  std::vector<int> textured, textureless;
+};
+
+Regions SplitByTexture(const SequenceModel& model, const Capture& capture) {
   std::vector<bool> textureless(model.num_fine_vertices(), false);
   for (int v : model.SubdivideIds(capture.textureless_vertices())) textureless[v] = true;
-  std::vector<int> textured;
+  Regions regions;
   for (int v : model.refined_vertices()) {
-    if (!textureless[v]) textured.push_back(v);
+    (textureless[v] ? regions.textureless : regions.textured).push_back(v);
   }
-  return textured;
+  return regions;
 }
 
 void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, const Mesh& coarse,
-                          int frame, const std::vector<int>& textured, const FrameResult& result,
+                          int frame, const Regions& regions, const FrameResult& result,
                           FrameStats* stats) {
   const Eigen::VectorXd truth = internal::TrueFineDisplacement(capture, model, coarse, frame);
   if (truth.size() == 0) return;
   // Only where the result has a displacement: both figures over the same vertices.
   const Eigen::VectorXd input = result.k.array().isFinite().select(0.0 * result.k, result.k);
-  stats->rms_coarse_mm = 1000.0 * ComputeErrorStats(input, truth, textured).rms;
-  stats->rms_refined_mm = 1000.0 * ComputeErrorStats(result.k, truth, textured).rms;
+  stats->rms_coarse_mm = 1000.0 * ComputeErrorStats(input, truth, regions.textured).rms;
+  stats->rms_refined_mm = 1000.0 * ComputeErrorStats(result.k, truth, regions.textured).rms;
+  stats->rms_textureless_coarse_mm =
+      1000.0 * ComputeErrorStats(input, truth, regions.textureless).rms;
+  stats->rms_textureless_refined_mm =
+      1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
 }
 
 void PrintProblemSize(const Capture& capture, const SequenceModel& model, int frames) {
@@ -97,7 +105,7 @@ int RunRefine(const Config& config) {
                             capture.directory() + "/meshes");
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
-  const std::vector<int> textured = TexturedVertices(model, capture);
+  const Regions regions = SplitByTexture(model, capture);
   PrintProblemSize(capture, model, frames.size());
 
   internal::Progress progress(frames.size());
@@ -119,7 +127,7 @@ int RunRefine(const Config& config) {
     previous_k = result.k_solved;
 
     FrameStats stats = MakeFrameStats(name, config.refine, result);
-    AddGroundTruthErrors(capture, model, input.coarse, frame, textured, result, &stats);
+    AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
     WriteMesh(paths.mesh, result.refined, {result.normals, {}, quality},
               config.output.mesh_format == "obj" ? MeshFormat::kObj : MeshFormat::kPly);

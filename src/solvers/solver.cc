@@ -35,9 +35,11 @@ double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
     for (double r : residuals) sum_of_squares += r * r;
   }
   // The regulariser's residuals are 2 sqrt(w T) u (k_a - k_b): their half sum of squares is
-  // w_reg * E_reg.
-  const double w_reg = energy->options().w_reg;
-  return 0.5 * sum_of_squares + w_reg * energy->regularizer().Evaluate(k, nullptr);
+  // w_reg * E_reg; the prior's, sqrt(2 w_prior) u k_s, give w_prior E_prior.
+  const EnergyOptions& options = energy->options();
+  const double u = options.RegUnitScale();
+  return 0.5 * sum_of_squares + options.w_reg * energy->regularizer().Evaluate(k, nullptr) +
+         options.w_prior * u * u * k.squaredNorm();
 }
 
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {
