@@ -15,6 +15,7 @@
 #include "finecap/config.h"
 #include "finecap/synth.h"
 #include "test_util.h"
+#include "tiny_synth.h"
 
 namespace finecap {
 namespace {
@@ -112,20 +113,15 @@ TEST(EvaluationTest, HeatMapRunsFromBlueToRedAndGreysUnknowns) {
   EXPECT_THROW(HeatMapColors(Eigen::VectorXd::Zero(1), 0.0), Error);
 }
 
-// 3 cameras of 96 x 96, a 16 x 8 skirt, 3 frames.
+// 3 cameras of 96 x 96 that see the skirt large, a 16 x 8 skirt, 3 frames.
 SynthOptions TinyCapture() {
-  SynthOptions options;
+  SynthOptions options = testing_util::TinySynthOptions();
   options.num_frames = 3;
-  options.skirt.around = 16;
   options.skirt.down = 8;
-  options.texture.width = 256;
-  options.texture.height = 128;
   options.cameras.count = 3;
   options.cameras.width = 96;
   options.cameras.height = 96;
   options.cameras.focal = 300.0;
-  options.render.supersampling = 1;
-  options.fold_ramp_frames = 0;
   return options;
 }
 
