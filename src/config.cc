@@ -19,6 +19,8 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
                     "Format of refined meshes (PLY is binary).", {"ply", "obj"});
   schema->AddInt("runtime.threads", &config->runtime.threads,
                  "Worker threads for parallel stages; 0 = all cores.", 0, 1024);
+  schema->AddInt("eval.camera", &config->eval.camera,
+                 "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
 }
 
 void AddModelKeys(Config* config, ConfigSchema* schema) {

@@ -1,37 +1,14 @@
 #include "finecap/frame_stats.h"
 
 #include <cmath>
-#include <iomanip>
 #include <sstream>
 
+#include "io_util.h"
+
 namespace finecap {
-namespace {
 
-std::string JsonString(const std::string& text) {
-  std::string quoted = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') {
-      quoted += '\\';
-      quoted += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
-      quoted += escaped;
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "\"";
-}
-
-std::string JsonNumber(double value) {
-  if (!std::isfinite(value)) return "null";
-  std::ostringstream text;
-  text << std::setprecision(10) << value;
-  return text.str();
-}
-
-}  // namespace
+using internal::JsonNumber;
+using internal::JsonString;
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result) {

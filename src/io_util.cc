@@ -1,13 +1,19 @@
 #include "io_util.h"
 
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <limits>
 #include <set>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include "finecap/atomic_file.h"
 #include "finecap/error.h"
 
 namespace finecap {
@@ -73,6 +79,40 @@ void RequireUniqueCameraNames(const std::vector<Camera>& cameras, const std::str
     Require(names.insert(camera.name).second, where,
             "camera name '" + camera.name + "' appears twice");
   }
+}
+
+std::string JsonString(const std::string& text) {
+  std::string quoted = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') {
+      quoted += '\\';
+      quoted += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof(escaped), "\\u%04x", c);
+      quoted += escaped;
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "\"";
+}
+
+std::string JsonNumber(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream text;
+  text << std::setprecision(10) << value;
+  return text.str();
+}
+
+void WritePng(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> buffer;
+  try {
+    Require(cv::imencode(".png", image, buffer), path, "cannot encode the image as PNG");
+  } catch (const cv::Exception& error) {
+    throw Error(path, std::string("cannot encode the image as PNG: ") + error.what());
+  }
+  WriteTextFileAtomically(path, std::string(buffer.begin(), buffer.end()));
 }
 
 }  // namespace internal

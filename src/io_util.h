@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 #include "finecap/camera.h"
 
 namespace finecap {
@@ -28,6 +30,18 @@ void ValidateCameraExceptUnknownSize(const Camera& camera, const std::string& wh
 
 // Throws Error(where, ...) when two cameras share a name.
 void RequireUniqueCameraNames(const std::vector<Camera>& cameras, const std::string& where);
+
+// `text` as a JSON string literal: quoted, with quotes, backslashes and control characters
+// escaped.
+std::string JsonString(const std::string& text);
+
+// `value` as a JSON number with 10 significant digits; "null" when it is not finite (JSON has no
+// NaN or infinity).
+std::string JsonNumber(double value);
+
+// Encodes `image` (8- or 16-bit, 1, 3 or 4 channels) as PNG and writes it to `path` atomically.
+// Throws Error naming the file when it cannot be encoded or written.
+void WritePng(const std::string& path, const cv::Mat& image);
 
 }  // namespace internal
 }  // namespace finecap

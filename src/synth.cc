@@ -19,6 +19,7 @@
 #include "finecap/error.h"
 #include "finecap/mesh_io.h"
 #include "finecap/mesh_ray_caster.h"
+#include "io_util.h"
 #include "synth_internal.h"
 
 namespace finecap {
@@ -200,16 +201,6 @@ std::string IdsText(const std::vector<int>& ids) {
   return text;
 }
 
-void WritePng(const std::string& path, const cv::Mat& image) {
-  std::vector<uchar> buffer;
-  try {
-    Require(cv::imencode(".png", image, buffer), path, "cannot encode the image as PNG");
-  } catch (const cv::Exception& error) {
-    throw Error(path, std::string("cannot encode the image as PNG: ") + error.what());
-  }
-  WriteTextFileAtomically(path, std::string(buffer.begin(), buffer.end()));
-}
-
 }  // namespace
 
 struct SyntheticCapture::Impl {
@@ -344,8 +335,8 @@ void GenerateSyntheticCapture(const SynthOptions& options, const std::string& ou
                             DisplacementText(frame.true_k));
     for (int c = 0; c < static_cast<int>(capture.true_cameras().size()); ++c) {
       const std::string camera = capture.true_cameras()[c].name;
-      WritePng((root / "images" / camera / (name + ".png")).string(),
-               capture.Image(frame, index, c));
+      internal::WritePng((root / "images" / camera / (name + ".png")).string(),
+                         capture.Image(frame, index, c));
     }
   }
 }

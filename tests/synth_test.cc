@@ -18,6 +18,7 @@
 #include "finecap/error.h"
 #include "finecap/mesh_io.h"
 #include "finecap/render.h"
+#include "tiny_synth.h"
 
 namespace finecap {
 namespace {
@@ -31,22 +32,7 @@ std::string FreshPath(const std::string& name) {
   return path.string();
 }
 
-// 2 cameras of 64 x 64, a 16 x 10 skirt (160 coarse vertices), 2 frames.
-SynthOptions TinyOptions() {
-  SynthOptions options;
-  options.num_frames = 2;
-  options.skirt.around = 16;
-  options.skirt.down = 10;
-  options.texture.width = 256;
-  options.texture.height = 128;
-  options.cameras.count = 2;
-  options.cameras.width = 64;
-  options.cameras.height = 64;
-  options.cameras.focal = 60.0;
-  options.render.supersampling = 1;
-  options.fold_ramp_frames = 0;
-  return options;
-}
+SynthOptions TinyOptions() { return testing_util::TinySynthOptions(); }
 
 std::string ReadText(const std::string& path) {
   std::ifstream stream(path, std::ios::binary);

@@ -63,6 +63,12 @@ const std::vector<Subcommand>& Subcommands() {
        " [--capture DIR] [--out DIR]",
        &RunRefine,
        {"config", "capture", "out", "frames", "solver", "threads", "set"}},
+      {"eval",
+       "Measure a refined run against the capture's ground truth: pictures, plots, "
+       "eval/metrics.json and eval/report.html in the output folder.",
+       "finecap eval --config FILE [--capture DIR] [--out DIR] [--frames A:B]",
+       &RunEval,
+       {"config", "capture", "out", "frames", "set"}},
   };
   return kSubcommands;
 }

@@ -16,6 +16,14 @@ int RunRefine(const Config& config);
 // the working directory) and ends with the line "alpha_optimum: <value>".
 int RunProbe(const Config& config, int frame);
 
+// Measures the refined run in output.dir (a previous RunRefine on the same capture and config)
+// against the capture's ground truth and writes output.dir/eval/: frame_<frame>.png (image,
+// input normals, refined normals of camera eval.camera), error_<frame>.png (|k - k_true| as a
+// heat map), rms.png and normal_error.png, metrics.json and report.html. Frames without ground
+// truth get pictures and null figures. Throws Error naming output.dir when it holds no refined
+// frame of the configured range.
+int RunEval(const Config& config);
+
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 

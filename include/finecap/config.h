@@ -37,10 +37,18 @@ struct RuntimeConfig {
   int threads = 0;
 };
 
+// How `finecap eval` evaluates a refined run.
+struct EvalConfig {
+  // Index of the camera whose view the per-frame pictures show (0 = the first of the rig); must
+  // be < the capture's camera count, which eval checks. Default 0.
+  int camera = 0;
+};
+
 struct Config {
   CaptureConfig capture;
   OutputConfig output;
   RuntimeConfig runtime;
+  EvalConfig eval;
   // Index, in the capture's sorted frame list, of the frame whose images colour the surface
   // Gaussians. Default 0 (the paper: "typically the first frame").
   int reference_frame = 0;

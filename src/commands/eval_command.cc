@@ -1,0 +1,309 @@
+// finecap eval: a refined run measured against the capture's ground truth; pictures, plots,
+// metrics.json and report.html in output.dir/eval/.
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+
+#include "commands/command_util.h"
+#include "finecap/atomic_file.h"
+#include "finecap/commands.h"
+#include "finecap/error.h"
+#include "finecap/evaluation.h"
+#include "finecap/html_report.h"
+#include "finecap/mesh_io.h"
+#include "finecap/plot.h"
+#include "finecap/render.h"
+#include "io_util.h"
+
+namespace finecap {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The files `finecap refine` wrote for one frame.
+struct RefinedFrame {
+  int index = 0;
+  std::string name, mesh, displacement;
+};
+
+// The configured frames whose refined mesh and displacement exist in `out`, in frame order.
+std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
+                                            const std::string& out) {
+  const FrameRange range = internal::ConfiguredFrames(config, capture);
+  std::vector<RefinedFrame> frames;
+  for (int frame = range.begin; frame < range.end; ++frame) {
+    const std::string& name = capture.frame_name(frame);
+    RefinedFrame refined{frame, name, out + "/meshes/" + name + "." + config.output.mesh_format,
+                         out + "/k/" + name + ".txt"};
+    if (fs::is_regular_file(refined.mesh) && fs::is_regular_file(refined.displacement)) {
+      frames.push_back(refined);
+    }
+  }
+  Require(!frames.empty(), out,
+          "holds no refined run of the configured frames of " + capture.directory() +
+              " (no meshes/<frame>." + config.output.mesh_format +
+              " with k/<frame>.txt): run finecap refine first");
+  return frames;
+}
+
+// A k/<frame>.txt file: one number (or nan) per fine vertex, '#' lines are comments.
+Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
+  std::istringstream text(internal::ReadWholeFile(path));
+  std::vector<double> values;
+  std::string line;
+  for (int line_number = 1; std::getline(text, line); ++line_number) {
+    if (line.empty() || line[0] == '#') continue;
+    double value = 0.0;
+    Require(
+        internal::ParseDouble(line, &value) && !std::isinf(value), path,
+        "line " + std::to_string(line_number) + ": expected a number or nan, got '" + line + "'");
+    values.push_back(value);
+  }
+  Require(static_cast<int>(values.size()) == num_vertices, path,
+          "holds " + std::to_string(values.size()) + " displacements, the refined mesh has " +
+              std::to_string(num_vertices) + " vertices");
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+}
+
+// |k - k_true| per vertex; NaN where either is unknown.
+Eigen::VectorXd AbsoluteErrors(const EvaluationSamples& samples) {
+  return (samples.k_refined - samples.k_true).cwiseAbs();
+}
+
+// Input image | normals of the input | normals of the refined mesh (the paper's Figure 4).
+cv::Mat SideBySidePicture(const cv::Mat& image, const Camera& camera, const Mesh& input,
+                          const Mesh& refined) {
+  cv::Mat picture;
+  cv::hconcat(
+      std::vector<cv::Mat>{image, RenderNormals(camera, input), RenderNormals(camera, refined)},
+      picture);
+  return picture;
+}
+
+// What the sequence figures and the report collect while the frames are evaluated.
+struct EvaluationRun {
+  std::vector<std::string> names;
+  std::vector<double> frame_indices;
+  std::vector<EvaluationFigures> figures;
+  EvaluationSamples pooled;
+  std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
+};
+
+void EvaluateFrame(const RefinedFrame& frame, const Config& config, const SequenceModel& model,
+                   const std::vector<int>& textureless, const std::string& eval_dir,
+                   Capture* capture, EvaluationRun* run) {
+  const Mesh coarse = capture->ReadCoarseMesh(frame.index);
+  const Mesh input = model.Subdivide(coarse);
+  const Mesh refined = ReadMesh(frame.mesh);
+  const Eigen::VectorXd k = ReadDisplacement(frame.displacement, input.num_vertices());
+  Eigen::VectorXd k_true = internal::TrueFineDisplacement(*capture, model, coarse, frame.index);
+  if (k_true.size() == 0) k_true = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
+  const EvaluationSamples samples = MakeEvaluationSamples(
+      input, refined, k, k_true, model.refined_vertices(), textureless, frame.mesh);
+  const EvaluationFigures figures = ComputeEvaluationFigures(samples);
+  run->names.push_back(frame.name);
+  run->frame_indices.push_back(frame.index);
+  run->figures.push_back(figures);
+  run->pooled.Append(samples);
+
+  const Camera& camera = capture->cameras()[config.eval.camera];
+  const std::string picture = eval_dir + "/frame_" + frame.name + ".png";
+  internal::WritePng(picture, SideBySidePicture(capture->ReadImage(config.eval.camera, frame.index),
+                                                camera, input, refined));
+  run->pictures.push_back({picture, "Frame " + frame.name + ", camera " + camera.name +
+                                        ": image, normals of the input, normals refined"});
+  const double scale = figures.all.coarse.p95_abs;
+  if (!(scale > 0.0)) return;  // No ground truth (or no detail): no error to colour.
+  SurfaceAppearance heat;
+  heat.vertex_colors = HeatMapColors(AbsoluteErrors(samples), scale);
+  const std::string heat_path = eval_dir + "/error_" + frame.name + ".png";
+  internal::WritePng(heat_path, RenderColor(camera, refined, heat));
+  std::ostringstream caption;
+  caption.precision(3);
+  caption << "Frame " << frame.name << ": |k - k_true| on the refined mesh, blue 0 to dark red "
+          << 1000.0 * scale << " mm (95th percentile of the input's error); grey unknown";
+  run->pictures.push_back({heat_path, caption.str()});
+}
+
+double Millimetres(double metres) { return 1000.0 * metres; }
+
+std::string RegionJson(const RegionFigures& region) {
+  using internal::JsonNumber;
+  std::ostringstream json;
+  json << "{\"vertices\": " << region.refined.count
+       << ", \"rms_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.rms))
+       << ", \"rms_refined_mm\": " << JsonNumber(Millimetres(region.refined.rms))
+       << ", \"mean_abs_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.mean_abs))
+       << ", \"mean_abs_refined_mm\": " << JsonNumber(Millimetres(region.refined.mean_abs))
+       << ", \"p95_abs_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.p95_abs))
+       << ", \"p95_abs_refined_mm\": " << JsonNumber(Millimetres(region.refined.p95_abs))
+       << ", \"detail_recovered\": " << JsonNumber(region.detail_recovered)
+       << ", \"normal_error_coarse_deg\": " << JsonNumber(region.normal_error_coarse_deg)
+       << ", \"normal_error_refined_deg\": " << JsonNumber(region.normal_error_refined_deg) << "}";
+  return json.str();
+}
+
+std::string FiguresJson(const EvaluationFigures& figures) {
+  return "{\"all\": " + RegionJson(figures.all) +
+         ", \"textured\": " + RegionJson(figures.textured) +
+         ", \"textureless\": " + RegionJson(figures.textureless) + "}";
+}
+
+// The headline figures (all refined vertices, the sequence pooled) at the top level, then the
+// regions of the sequence and of every frame.
+std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& sequence) {
+  using internal::JsonNumber;
+  const RegionFigures& all = sequence.all;
+  std::ostringstream json;
+  json << "{\n  \"rms_coarse_mm\": " << JsonNumber(Millimetres(all.coarse.rms))
+       << ",\n  \"rms_refined_mm\": " << JsonNumber(Millimetres(all.refined.rms))
+       << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
+       << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
+       << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
+       << ",\n  \"flow_coarse_px\": null,\n  \"flow_refined_px\": null"
+       << ",\n  \"flow_improvement_percent\": null"
+       << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
+  for (size_t i = 0; i < run.names.size(); ++i) {
+    json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
+         << ", \"figures\": " << FiguresJson(run.figures[i]) << "}";
+  }
+  json << "\n  ]\n}\n";
+  return json.str();
+}
+
+// One curve of a figure over the frames.
+PlotSeries SeriesOverFrames(const std::string& name, const EvaluationRun& run,
+                            double (*figure)(const EvaluationFigures&)) {
+  PlotSeries series{name, run.frame_indices, {}};
+  for (const EvaluationFigures& figures : run.figures) series.y.push_back(figure(figures));
+  return series;
+}
+
+bool AnyFinite(const PlotSeries& series) {
+  for (double y : series.y) {
+    if (std::isfinite(y)) return true;
+  }
+  return false;
+}
+
+// The two plots over the frames, when there is ground truth to plot; returns their paths.
+std::vector<std::pair<std::string, std::string>> WritePlots(const EvaluationRun& run,
+                                                            const std::string& eval_dir) {
+  const std::vector<PlotSeries> rms = {
+      SeriesOverFrames("input", run,
+                       [](const EvaluationFigures& f) { return Millimetres(f.all.coarse.rms); }),
+      SeriesOverFrames("refined", run,
+                       [](const EvaluationFigures& f) { return Millimetres(f.all.refined.rms); })};
+  const std::vector<PlotSeries> normals = {
+      SeriesOverFrames("input", run,
+                       [](const EvaluationFigures& f) { return f.all.normal_error_coarse_deg; }),
+      SeriesOverFrames("refined", run,
+                       [](const EvaluationFigures& f) { return f.all.normal_error_refined_deg; })};
+  if (!AnyFinite(rms[0])) return {};
+  PlotOptions options;
+  options.x_label = "frame";
+  options.title = "RMS of |k - k_true| over the refined vertices";
+  options.y_label = "mm";
+  WriteLinePlot(eval_dir + "/rms.png", rms, options);
+  options.title = "Mean angle between vertex normals and the true normals";
+  options.y_label = "degrees";
+  WriteLinePlot(eval_dir + "/normal_error.png", normals, options);
+  return {{eval_dir + "/rms.png", "Displacement error over the frames"},
+          {eval_dir + "/normal_error.png", "Normal error over the frames"}};
+}
+
+std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& region) {
+  return {name,
+          region.refined.count,
+          Millimetres(region.coarse.rms),
+          Millimetres(region.refined.rms),
+          Millimetres(region.coarse.mean_abs),
+          Millimetres(region.refined.mean_abs),
+          Millimetres(region.coarse.p95_abs),
+          Millimetres(region.refined.p95_abs),
+          100.0 * region.detail_recovered,
+          region.normal_error_coarse_deg,
+          region.normal_error_refined_deg};
+}
+
+void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
+                 const std::vector<std::pair<std::string, std::string>>& plots,
+                 const std::string& path) {
+  const std::vector<std::string> header = {"",
+                                           "vertices",
+                                           "RMS input mm",
+                                           "RMS refined mm",
+                                           "mean input mm",
+                                           "mean refined mm",
+                                           "p95 input mm",
+                                           "p95 refined mm",
+                                           "detail recovered %",
+                                           "normal error input deg",
+                                           "normal error refined deg"};
+  HtmlReport report("finecap evaluation");
+  report.AddSection("Figures");
+  report.AddParagraph(
+      "Errors of the displacement k along the normals of the subdivided input mesh against the "
+      "ground truth, over the refined vertices (input = k of 0). True normals: the input mesh "
+      "displaced by the true k. n/a: no ground truth or an empty region.");
+  report.AddTable(header,
+                  {TableRow("all", sequence.all), TableRow("textured", sequence.textured),
+                   TableRow("textureless", sequence.textureless)},
+                  "The whole sequence, vertices of all frames pooled");
+  std::vector<std::vector<TableCell>> frame_rows;
+  for (size_t i = 0; i < run.names.size(); ++i) {
+    frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
+  }
+  report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  if (!plots.empty()) report.AddSection("Over the frames");
+  for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
+  report.AddSection("Pictures");
+  for (const auto& [picture, caption] : run.pictures) report.AddImageFile(picture, caption);
+  report.Write(path);
+}
+
+}  // namespace
+
+int RunEval(const Config& config) {
+  Capture capture = internal::OpenConfiguredCapture(config);
+  Require(!config.output.dir.empty(), "output.dir",
+          "no refined run given (set output.dir or pass --out DIR)");
+  Require(fs::is_directory(config.output.dir), config.output.dir,
+          "is not a folder: expected the output.dir of a finecap refine run");
+  Require(config.eval.camera < capture.num_cameras(), "eval.camera",
+          std::to_string(config.eval.camera) + " is not a camera of " + capture.directory() +
+              ", which has " + std::to_string(capture.num_cameras()));
+  const std::string out = config.output.dir;
+  const std::vector<RefinedFrame> frames = FindRefinedFrames(config, capture, out);
+  const std::string eval_dir = out + "/eval";
+  fs::create_directories(eval_dir);
+
+  const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
+                            capture.directory() + "/meshes");
+  const std::vector<int> textureless = model.SubdivideIds(capture.textureless_vertices());
+  EvaluationRun run;
+  internal::Progress progress(frames.size());
+  for (const RefinedFrame& frame : frames) {
+    EvaluateFrame(frame, config, model, textureless, eval_dir, &capture, &run);
+    progress.FrameDone(frame.name, false, "");
+  }
+  const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
+  WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
+  WriteReport(run, sequence, WritePlots(run, eval_dir), eval_dir + "/report.html");
+
+  std::cout.precision(3);
+  std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
+  if (std::isfinite(sequence.all.coarse.rms)) {
+    std::cout << "RMS against the ground truth: input " << Millimetres(sequence.all.coarse.rms)
+              << " mm, refined " << Millimetres(sequence.all.refined.rms)
+              << " mm; detail recovered " << 100.0 * sequence.all.detail_recovered
+              << " %; normal error " << sequence.all.normal_error_coarse_deg << " -> "
+              << sequence.all.normal_error_refined_deg << " degrees\n";
+  }
+  return 0;
+}
+
+}  // namespace finecap

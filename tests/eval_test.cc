@@ -1,0 +1,200 @@
+// finecap eval: the figures of the evaluation against independent computations, and the whole
+// command on a tiny refined synthetic run (metrics.json, pictures, report), plus its bad input.
+#include "finecap/evaluation.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "finecap/commands.h"
+#include "finecap/config.h"
+#include "finecap/synth.h"
+#include "test_util.h"
+#include "tiny_synth.h"
+
+namespace finecap {
+namespace {
+
+namespace fs = std::filesystem;
+using testing_util::ExpectErrorMentions;
+using testing_util::FileBytes;
+using testing_util::MakeTempDir;
+
+// A flat 3 x 3 grid of vertices in the plane z = 0, normals along +z.
+Mesh FlatGrid() {
+  Mesh mesh;
+  mesh.vertices.resize(3, 9);
+  for (int v = 0; v < 9; ++v) mesh.vertices.col(v) << v % 3, v / 3, 0.0;
+  mesh.faces.resize(3, 8);
+  int f = 0;
+  for (int row = 0; row < 2; ++row) {
+    for (int col = 0; col < 2; ++col) {
+      const int a = 3 * row + col;
+      mesh.faces.col(f++) << a, a + 1, a + 4;
+      mesh.faces.col(f++) << a, a + 4, a + 3;
+    }
+  }
+  return mesh;
+}
+
+TEST(EvaluationTest, FiguresMatchAHandComputation) {
+  const Mesh input = FlatGrid();
+  Eigen::VectorXd k_true = Eigen::VectorXd::Zero(9);
+  k_true[4] = 0.5;  // The centre vertex bulges: its four neighbours tilt.
+  Eigen::VectorXd k = 0.5 * k_true;
+  k[0] = std::nan("");  // Not refined: left out of both the input's and the refinement's error.
+  Mesh refined = input;
+  refined.vertices(2, 4) = k[4];
+  const std::vector<int> region = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  const EvaluationSamples samples =
+      MakeEvaluationSamples(input, refined, k, k_true, region, {4}, "grid");
+  EXPECT_EQ(samples.textureless, std::vector<int>{4});
+  EXPECT_EQ(samples.textured.size(), 8u);
+
+  const EvaluationFigures figures = ComputeEvaluationFigures(samples);
+  EXPECT_EQ(figures.all.coarse.count, 8);
+  EXPECT_NEAR(figures.all.coarse.rms, std::sqrt(0.25 / 8), 1e-12);
+  EXPECT_NEAR(figures.all.refined.rms, std::sqrt(0.0625 / 8), 1e-12);
+  EXPECT_NEAR(figures.all.detail_recovered, 0.5, 1e-12);
+  EXPECT_NEAR(figures.textureless.refined.rms, 0.25, 1e-12);
+  EXPECT_NEAR(figures.textured.refined.rms, 0.0, 1e-12);
+  // The input is flat, so its normal error is the true normals' mean tilt from +z; the refined
+  // bulge is half as high, so it tilts less and errs less.
+  double tilt = 0.0;
+  for (int v = 1; v < 9; ++v) {
+    tilt += std::acos(std::min(1.0, samples.normals_true.col(v).normalized().z())) * 180.0 / M_PI;
+  }
+  EXPECT_NEAR(figures.all.normal_error_coarse_deg, tilt / 8, 1e-9);
+  EXPECT_GT(figures.all.normal_error_refined_deg, 0.0);
+  EXPECT_LT(figures.all.normal_error_refined_deg, figures.all.normal_error_coarse_deg);
+}
+
+TEST(EvaluationTest, PooledSamplesGiveTheFiguresOfBothFrames) {
+  const Mesh input = FlatGrid();
+  const Eigen::VectorXd k = Eigen::VectorXd::Zero(9);
+  const std::vector<int> region = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  EvaluationSamples pooled;
+  pooled.Append(MakeEvaluationSamples(input, input, k, Eigen::VectorXd::Constant(9, 0.1), region,
+                                      {}, "first"));
+  pooled.Append(MakeEvaluationSamples(input, input, k, Eigen::VectorXd::Constant(9, 0.3), region,
+                                      {}, "second"));
+  EXPECT_EQ(pooled.all.size(), 18u);
+  EXPECT_EQ(pooled.all.back(), 17);
+  EXPECT_NEAR(ComputeEvaluationFigures(pooled).all.refined.rms, std::sqrt((0.01 + 0.09) / 2),
+              1e-12);
+}
+
+TEST(EvaluationTest, RefusesMismatchedInputs) {
+  const Mesh input = FlatGrid();
+  ExpectErrorMentions(
+      [&] {
+        MakeEvaluationSamples(input, input, Eigen::VectorXd::Zero(8), Eigen::VectorXd::Zero(9), {},
+                              {}, "frame_7.ply");
+      },
+      {"frame_7.ply", "expected 9 displacements"});
+  ExpectErrorMentions(
+      [&] {
+        MakeEvaluationSamples(input, input, Eigen::VectorXd::Zero(9), Eigen::VectorXd::Zero(9), {9},
+                              {}, "frame_7.ply");
+      },
+      {"frame_7.ply", "vertex id 9"});
+}
+
+TEST(EvaluationTest, HeatMapRunsFromBlueToRedAndGreysUnknowns) {
+  const Eigen::Matrix3Xd colors = HeatMapColors(Eigen::Vector3d(0.0, 2.0, std::nan("")), 1.0);
+  EXPECT_GT(colors(2, 0), colors(0, 0));  // Zero error: blue dominates.
+  EXPECT_GT(colors(0, 1), colors(2, 1));  // Saturated: red dominates.
+  EXPECT_EQ(colors.col(2), Eigen::Vector3d::Constant(0.5));
+  EXPECT_THROW(HeatMapColors(Eigen::VectorXd::Zero(1), 0.0), Error);
+}
+
+// 3 cameras of 96 x 96 that see the skirt large, a 16 x 8 skirt, 3 frames.
+SynthOptions TinyCapture() {
+  SynthOptions options = testing_util::TinySynthOptions();
+  options.num_frames = 3;
+  options.skirt.down = 8;
+  options.cameras.count = 3;
+  options.cameras.width = 96;
+  options.cameras.height = 96;
+  options.cameras.focal = 300.0;
+  return options;
+}
+
+Config RunConfig(const std::string& capture, const std::string& out) {
+  Config config;
+  config.capture.dir = capture;
+  config.output.dir = out;
+  config.runtime.threads = 1;
+  config.refine.solver.max_iterations = 5;
+  config.refine.solver.num_threads = 1;
+  return config;
+}
+
+// True when `path` is a PNG of `width` x `height` pixels.
+bool IsPngOfSize(const std::string& path, int width, int height) {
+  const std::string bytes = FileBytes(path);
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0) return false;
+  const cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  return image.cols == width && image.rows == height;
+}
+
+TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
+  const std::string root = MakeTempDir("eval");
+  const std::string capture = root + "/capture";
+  const std::string out = root + "/run";
+  GenerateSyntheticCapture(TinyCapture(), capture);
+  const Config config = RunConfig(capture, out);
+  ASSERT_EQ(RunRefine(config), 0);
+  const auto refined_files = testing_util::FilesIn(out + "/meshes");
+  ASSERT_EQ(RunEval(config), 0);
+
+  const YAML::Node metrics = YAML::LoadFile(out + "/eval/metrics.json");  // JSON is YAML.
+  const double rms_coarse = metrics["rms_coarse_mm"].as<double>();
+  EXPECT_TRUE(std::isfinite(rms_coarse));
+  EXPECT_GT(rms_coarse, 0.0);
+  EXPECT_TRUE(std::isfinite(metrics["rms_refined_mm"].as<double>()));
+  EXPECT_TRUE(std::isfinite(metrics["normal_error_coarse_deg"].as<double>()));
+  EXPECT_TRUE(metrics["flow_coarse_px"].IsNull());
+  EXPECT_EQ(metrics["frames"].size(), 3u);
+  EXPECT_DOUBLE_EQ(metrics["sequence"]["all"]["rms_coarse_mm"].as<double>(), rms_coarse);
+
+  // Refine measures the textured region of each frame the same way, independently of eval.
+  for (int i = 0; i < 3; ++i) {
+    const YAML::Node figures = metrics["frames"][i]["figures"]["textured"];
+    const std::string name = metrics["frames"][i]["frame"].as<std::string>();
+    const YAML::Node stats = YAML::LoadFile(out + "/frames/" + name + ".json");
+    EXPECT_NEAR(figures["rms_coarse_mm"].as<double>(), stats["rms_coarse_mm"].as<double>(), 1e-6);
+    EXPECT_NEAR(figures["rms_refined_mm"].as<double>(), stats["rms_refined_mm"].as<double>(), 1e-6);
+  }
+  for (const std::string frame : {"000000", "000001", "000002"}) {
+    EXPECT_TRUE(IsPngOfSize(out + "/eval/frame_" + frame + ".png", 3 * 96, 96)) << frame;
+    EXPECT_TRUE(IsPngOfSize(out + "/eval/error_" + frame + ".png", 96, 96)) << frame;
+  }
+  EXPECT_TRUE(IsPngOfSize(out + "/eval/rms.png", 800, 500));
+  EXPECT_TRUE(IsPngOfSize(out + "/eval/normal_error.png", 800, 500));
+  const std::string report = FileBytes(out + "/eval/report.html");
+  EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_NE(report.find("detail recovered"), std::string::npos);
+  EXPECT_EQ(testing_util::FilesIn(out + "/meshes"), refined_files);  // Nothing else touched.
+}
+
+TEST(EvalCommandTest, RefusesAFolderWithoutARefinedRun) {
+  const std::string root = MakeTempDir("eval_empty");
+  const std::string capture = root + "/capture";
+  SynthOptions options = TinyCapture();
+  options.num_frames = 1;
+  GenerateSyntheticCapture(options, capture);
+  const std::string empty = root + "/not_a_run";
+  fs::create_directories(empty);
+  ExpectErrorMentions([&] { RunEval(RunConfig(capture, empty)); },
+                      {"not_a_run", "no refined run", "finecap refine"});
+  EXPECT_TRUE(testing_util::FilesIn(empty).empty());  // No eval/ folder left behind.
+}
+
+}  // namespace
+}  // namespace finecap

@@ -1,0 +1,31 @@
+// A synthetic capture small enough for unit tests, shared by the tests that generate one.
+#ifndef FINECAP_TESTS_TINY_SYNTH_H_
+#define FINECAP_TESTS_TINY_SYNTH_H_
+
+#include "finecap/synth.h"
+
+namespace finecap {
+namespace testing_util {
+
+// 2 cameras of 64 x 64, a 16 x 10 skirt (160 coarse vertices), 2 frames, a 256 x 128 texture, one
+// sample per pixel and folds at full amplitude from the first frame.
+inline SynthOptions TinySynthOptions() {
+  SynthOptions options;
+  options.num_frames = 2;
+  options.skirt.around = 16;
+  options.skirt.down = 10;
+  options.texture.width = 256;
+  options.texture.height = 128;
+  options.cameras.count = 2;
+  options.cameras.width = 64;
+  options.cameras.height = 64;
+  options.cameras.focal = 60.0;
+  options.render.supersampling = 1;
+  options.fold_ramp_frames = 0;
+  return options;
+}
+
+}  // namespace testing_util
+}  // namespace finecap
+
+#endif  // FINECAP_TESTS_TINY_SYNTH_H_
