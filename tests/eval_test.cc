@@ -1,6 +1,8 @@
 // finecap eval: the figures of the evaluation against independent computations, and the whole
 // command on a tiny refined synthetic run (metrics.json, pictures, report), plus its bad input.
 #include "finecap/evaluation.h"
+#include "finecap/export.h"
+#include "finecap/mesh_io.h"
 
 #include <cmath>
 #include <filesystem>
@@ -181,6 +183,15 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(report.find("detail recovered"), std::string::npos);
   EXPECT_EQ(testing_util::FilesIn(out + "/meshes"), refined_files);  // Nothing else touched.
+
+  // The same run exported: one PC2 sample per frame holding the refined vertices.
+  ASSERT_EQ(RunExport(config), 0);
+  const Pc2Cache cache = ReadPc2(out + "/export/sequence.pc2");
+  const Mesh last = ReadMesh(out + "/meshes/000002.ply");
+  ASSERT_EQ(cache.header.num_samples, 3);
+  ASSERT_EQ(cache.header.num_points, last.num_vertices());
+  EXPECT_LT((cache.samples.back().cast<double>() - last.vertices).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_EQ(testing_util::FilesIn(out + "/export/ply").size(), 3u);
 }
 
 TEST(EvalCommandTest, RefusesAFolderWithoutARefinedRun) {

@@ -56,6 +56,12 @@ const std::vector<Subcommand>& Subcommands() {
        "finecap probe --config FILE --capture DIR [--frame N] [--out DIR]",
        [](const Config& config) { return RunProbe(config, FLAGS_frame); },
        {"config", "capture", "out", "frame", "set"}},
+      {"export",
+       "Write a refined run for animation tools: a PC2 point cache (Blender's Mesh Cache) and "
+       "per-frame PLY with the displacement as vertex quality (MeshLab).",
+       "finecap export --config FILE [--capture DIR] [--out DIR] [--frames A:B]",
+       &RunExport,
+       {"config", "capture", "out", "frames", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
        "finecap refine --config configs/demo.yaml [--frames A:B] [--solver "

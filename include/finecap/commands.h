@@ -24,6 +24,10 @@ int RunProbe(const Config& config, int frame);
 // frame of the configured range.
 int RunEval(const Config& config);
 
+// Writes a refined run (output.dir) as a PC2 point cache and per-frame PLY files with the
+// displacement as vertex quality, in output.dir/export/.
+int RunExport(const Config& config);
+
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 

@@ -6,9 +6,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <sstream>
 
 #include "finecap/error.h"
 #include "finecap/ground_truth.h"
+#include "io_util.h"
 
 namespace finecap {
 namespace internal {
@@ -42,6 +44,14 @@ std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
   Require(!error && fs::is_directory(out), config.output.dir,
           "cannot create the output folder: " + error.message());
   return out.string();
+}
+
+std::string RefinedRunFolder(const Config& config) {
+  Require(!config.output.dir.empty(), "output.dir",
+          "no folder of a refined run given (set output.dir or pass --out DIR)");
+  Require(fs::is_directory(config.output.dir), config.output.dir,
+          "no such folder: run finecap refine first");
+  return fs::canonical(config.output.dir).string();
 }
 
 FrameInput ReadFrameInput(Capture* capture, int frame) {
@@ -83,6 +93,44 @@ Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel
   const Mesh fine = model.Subdivide(coarse);
   return TrueDisplacementAlongNormals(fine.vertices, ComputeVertexNormals(fine),
                                       capture.ReadTrueSurface(frame), 0.1);
+}
+
+std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
+                                            const std::string& out) {
+  const FrameRange range = internal::ConfiguredFrames(config, capture);
+  std::vector<RefinedFrame> frames;
+  for (int frame = range.begin; frame < range.end; ++frame) {
+    const std::string& name = capture.frame_name(frame);
+    RefinedFrame refined{frame, name, out + "/meshes/" + name + "." + config.output.mesh_format,
+                         out + "/k/" + name + ".txt"};
+    if (fs::is_regular_file(refined.mesh) && fs::is_regular_file(refined.displacement)) {
+      frames.push_back(refined);
+    }
+  }
+  Require(!frames.empty(), out,
+          "holds no refined run of the configured frames of " + capture.directory() +
+              " (no meshes/<frame>." + config.output.mesh_format +
+              " with k/<frame>.txt): run finecap refine first");
+  return frames;
+}
+
+// A k/<frame>.txt file: one number (or nan) per fine vertex, '#' lines are comments.
+Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
+  std::istringstream text(internal::ReadWholeFile(path));
+  std::vector<double> values;
+  std::string line;
+  for (int line_number = 1; std::getline(text, line); ++line_number) {
+    if (line.empty() || line[0] == '#') continue;
+    double value = 0.0;
+    Require(
+        internal::ParseDouble(line, &value) && !std::isinf(value), path,
+        "line " + std::to_string(line_number) + ": expected a number or nan, got '" + line + "'");
+    values.push_back(value);
+  }
+  Require(static_cast<int>(values.size()) == num_vertices, path,
+          "holds " + std::to_string(values.size()) + " displacements, the refined mesh has " +
+              std::to_string(num_vertices) + " vertices");
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
 }
 
 Progress::Progress(int total)

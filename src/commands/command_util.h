@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <string>
+#include <vector>
 
 #include "finecap/capture.h"
 #include "finecap/config.h"
@@ -23,6 +24,9 @@ FrameRange ConfiguredFrames(const Config& config, const Capture& capture);
 // itself or a folder inside it, so that nothing a user gave is ever written over.
 std::string PrepareOutputFolder(const Config& config, const Capture& capture);
 
+// output.dir of a previous `finecap refine`, which must exist (nothing is created).
+std::string RefinedRunFolder(const Config& config);
+
 // The coarse mesh, cameras and undistorted images of one frame.
 FrameInput ReadFrameInput(Capture* capture, int frame);
 
@@ -35,6 +39,20 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
 // vector when the capture has no true surface for the frame.
 Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
                                      const Mesh& coarse, int frame);
+
+// The files `finecap refine` wrote for one frame.
+struct RefinedFrame {
+  int index = 0;
+  std::string name, mesh, displacement;
+};
+
+// The configured frames whose refined mesh and displacement exist in `out`, in frame order;
+// an Error naming `out` when there is none.
+std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
+                                            const std::string& out);
+
+// A k/<frame>.txt file: one number (or nan) per vertex of the refined mesh.
+Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices);
 
 // Progress of a run over frames: a line rewritten in place on a terminal, plain lines otherwise.
 class Progress {

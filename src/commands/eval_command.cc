@@ -23,51 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The files `finecap refine` wrote for one frame.
-struct RefinedFrame {
-  int index = 0;
-  std::string name, mesh, displacement;
-};
-
-// The configured frames whose refined mesh and displacement exist in `out`, in frame order.
-std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
-                                            const std::string& out) {
-  const FrameRange range = internal::ConfiguredFrames(config, capture);
-  std::vector<RefinedFrame> frames;
-  for (int frame = range.begin; frame < range.end; ++frame) {
-    const std::string& name = capture.frame_name(frame);
-    RefinedFrame refined{frame, name, out + "/meshes/" + name + "." + config.output.mesh_format,
-                         out + "/k/" + name + ".txt"};
-    if (fs::is_regular_file(refined.mesh) && fs::is_regular_file(refined.displacement)) {
-      frames.push_back(refined);
-    }
-  }
-  Require(!frames.empty(), out,
-          "holds no refined run of the configured frames of " + capture.directory() +
-              " (no meshes/<frame>." + config.output.mesh_format +
-              " with k/<frame>.txt): run finecap refine first");
-  return frames;
-}
-
-// A k/<frame>.txt file: one number (or nan) per fine vertex, '#' lines are comments.
-Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
-  std::istringstream text(internal::ReadWholeFile(path));
-  std::vector<double> values;
-  std::string line;
-  for (int line_number = 1; std::getline(text, line); ++line_number) {
-    if (line.empty() || line[0] == '#') continue;
-    double value = 0.0;
-    Require(
-        internal::ParseDouble(line, &value) && !std::isinf(value), path,
-        "line " + std::to_string(line_number) + ": expected a number or nan, got '" + line + "'");
-    values.push_back(value);
-  }
-  Require(static_cast<int>(values.size()) == num_vertices, path,
-          "holds " + std::to_string(values.size()) + " displacements, the refined mesh has " +
-              std::to_string(num_vertices) + " vertices");
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
-}
-
 // |k - k_true| per vertex; NaN where either is unknown.
 Eigen::VectorXd AbsoluteErrors(const EvaluationSamples& samples) {
   return (samples.k_refined - samples.k_true).cwiseAbs();
@@ -92,13 +47,13 @@ struct EvaluationRun {
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
 
-void EvaluateFrame(const RefinedFrame& frame, const Config& config, const SequenceModel& model,
-                   const std::vector<int>& textureless, const std::string& eval_dir,
-                   Capture* capture, EvaluationRun* run) {
+void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
+                   const SequenceModel& model, const std::vector<int>& textureless,
+                   const std::string& eval_dir, Capture* capture, EvaluationRun* run) {
   const Mesh coarse = capture->ReadCoarseMesh(frame.index);
   const Mesh input = model.Subdivide(coarse);
   const Mesh refined = ReadMesh(frame.mesh);
-  const Eigen::VectorXd k = ReadDisplacement(frame.displacement, input.num_vertices());
+  const Eigen::VectorXd k = internal::ReadDisplacement(frame.displacement, input.num_vertices());
   Eigen::VectorXd k_true = internal::TrueFineDisplacement(*capture, model, coarse, frame.index);
   if (k_true.size() == 0) k_true = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
   const EvaluationSamples samples = MakeEvaluationSamples(
@@ -269,15 +224,12 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
 
 int RunEval(const Config& config) {
   Capture capture = internal::OpenConfiguredCapture(config);
-  Require(!config.output.dir.empty(), "output.dir",
-          "no refined run given (set output.dir or pass --out DIR)");
-  Require(fs::is_directory(config.output.dir), config.output.dir,
-          "is not a folder: expected the output.dir of a finecap refine run");
+  const std::string out = internal::RefinedRunFolder(config);
   Require(config.eval.camera < capture.num_cameras(), "eval.camera",
           std::to_string(config.eval.camera) + " is not a camera of " + capture.directory() +
               ", which has " + std::to_string(capture.num_cameras()));
-  const std::string out = config.output.dir;
-  const std::vector<RefinedFrame> frames = FindRefinedFrames(config, capture, out);
+  const std::vector<internal::RefinedFrame> frames =
+      internal::FindRefinedFrames(config, capture, out);
   const std::string eval_dir = out + "/eval";
   fs::create_directories(eval_dir);
 
@@ -286,7 +238,7 @@ int RunEval(const Config& config) {
   const std::vector<int> textureless = model.SubdivideIds(capture.textureless_vertices());
   EvaluationRun run;
   internal::Progress progress(frames.size());
-  for (const RefinedFrame& frame : frames) {
+  for (const internal::RefinedFrame& frame : frames) {
     EvaluateFrame(frame, config, model, textureless, eval_dir, &capture, &run);
     progress.FrameDone(frame.name, false, "");
   }
