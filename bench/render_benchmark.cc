@@ -6,37 +6,11 @@
 #include <benchmark/benchmark.h>
 #include <Eigen/Geometry>
 
+#include "../tests/test_meshes.h"
 #include "finecap/render.h"
 
 namespace finecap {
 namespace {
-
-// A closed lat-long sphere of radius 0.4 m at the origin, 2 * rings * segments triangles.
-Mesh MakeSubject(int rings, int segments) {
-  Mesh mesh;
-  mesh.vertices.resize(3, (rings + 1) * segments);
-  for (int i = 0; i <= rings; ++i) {
-    for (int j = 0; j < segments; ++j) {
-      const double theta = M_PI * i / rings;
-      const double phi = 2.0 * M_PI * j / segments;
-      mesh.vertices.col(i * segments + j) =
-          0.4 * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                std::sin(theta) * std::sin(phi));
-    }
-  }
-  std::vector<Eigen::Vector3i> faces;
-  for (int i = 0; i < rings; ++i) {
-    for (int j = 0; j < segments; ++j) {
-      const int a = i * segments + j;
-      const int b = i * segments + (j + 1) % segments;
-      faces.emplace_back(a, b, a + segments);
-      faces.emplace_back(b, b + segments, a + segments);
-    }
-  }
-  mesh.faces.resize(3, faces.size());
-  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.col(f) = faces[f];
-  return mesh;
-}
 
 std::vector<Camera> MakeRing(int count) {
   std::vector<Camera> cameras;
@@ -73,7 +47,7 @@ SurfaceAppearance MakeTexturedAppearance(const Mesh& mesh) {
 }
 
 void BM_RenderColorEightCameras(benchmark::State& state) {
-  const Mesh mesh = MakeSubject(100, 200);
+  const Mesh mesh = testing_meshes::SphereMesh(Eigen::Vector3d::Zero(), 0.4, 100, 200);
   const std::vector<Camera> cameras = MakeRing(8);
   const SurfaceAppearance appearance = MakeTexturedAppearance(mesh);
   RenderOptions options;
@@ -89,7 +63,7 @@ void BM_RenderColorEightCameras(benchmark::State& state) {
 BENCHMARK(BM_RenderColorEightCameras)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RenderDepthEightCameras(benchmark::State& state) {
-  const Mesh mesh = MakeSubject(100, 200);
+  const Mesh mesh = testing_meshes::SphereMesh(Eigen::Vector3d::Zero(), 0.4, 100, 200);
   const std::vector<Camera> cameras = MakeRing(8);
   for (auto _ : state) {
     for (const Camera& camera : cameras) {

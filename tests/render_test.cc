@@ -10,6 +10,7 @@
 #include <Eigen/LU>
 
 #include "finecap/error.h"
+#include "test_meshes.h"
 
 namespace finecap {
 namespace {
@@ -78,38 +79,12 @@ TEST(RenderTest, DepthOfTiltedPlaneMatchesRayIntersection) {
   }
 }
 
-Mesh MakeSphere(const Eigen::Vector3d& center, double radius, int rings, int segments) {
-  Mesh mesh;
-  mesh.vertices.resize(3, (rings + 1) * segments);
-  for (int i = 0; i <= rings; ++i) {
-    const double theta = M_PI * i / rings;
-    for (int j = 0; j < segments; ++j) {
-      const double phi = 2.0 * M_PI * j / segments;
-      mesh.vertices.col(i * segments + j) =
-          center + radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::cos(theta),
-                                            std::sin(theta) * std::sin(phi));
-    }
-  }
-  std::vector<Eigen::Vector3i> faces;
-  for (int i = 0; i < rings; ++i) {
-    for (int j = 0; j < segments; ++j) {
-      const int a = i * segments + j;
-      const int b = i * segments + (j + 1) % segments;
-      if (i > 0) faces.emplace_back(a, b, a + segments);
-      if (i + 1 < rings) faces.emplace_back(b, b + segments, a + segments);
-    }
-  }
-  mesh.faces.resize(3, faces.size());
-  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.col(f) = faces[f];
-  return mesh;
-}
-
 TEST(RenderTest, DepthOfSphereMatchesAnalyticIntersection) {
   const Camera camera = LookAt(MakeCamera(200, 200, 300.0), Eigen::Vector3d(0.3, -0.2, 0.0),
                                Eigen::Vector3d(0.0, 0.0, 3.0), Eigen::Vector3d(0, -1, 0));
   const Eigen::Vector3d center(0.0, 0.0, 3.0);
   const double radius = 0.5;
-  const Mesh sphere = MakeSphere(center, radius, 200, 400);
+  const Mesh sphere = testing_meshes::SphereMesh(center, radius, 200, 400);
   const DepthMap map = RenderDepth(camera, sphere);
   int checked = 0;
   for (int y = 0; y < camera.height; y += 3) {

@@ -3,6 +3,7 @@
 #define FINECAP_TESTS_TEST_MESHES_H_
 
 #include <cmath>
+#include <vector>
 
 #include "finecap/mesh.h"
 
@@ -72,6 +73,34 @@ inline Mesh TubeMesh(int segments, int rings, double radius = 1.0, double height
       mesh.faces.col(f++) << a, d, c;
     }
   }
+  return mesh;
+}
+
+// A latitude-longitude sphere: rings + 1 rows of `segments` vertices from pole to pole (each
+// pole repeated `segments` times), without the zero-area triangles at the poles.
+inline Mesh SphereMesh(const Eigen::Vector3d& center, double radius, int rings, int segments) {
+  Mesh mesh;
+  mesh.vertices.resize(3, (rings + 1) * segments);
+  for (int i = 0; i <= rings; ++i) {
+    const double theta = M_PI * i / rings;
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2.0 * M_PI * j / segments;
+      mesh.vertices.col(i * segments + j) =
+          center + radius * Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                            std::sin(theta) * std::sin(phi));
+    }
+  }
+  std::vector<Eigen::Vector3i> faces;
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      const int a = i * segments + j;
+      const int b = i * segments + (j + 1) % segments;
+      if (i > 0) faces.emplace_back(a, b, a + segments);
+      if (i + 1 < rings) faces.emplace_back(b, b + segments, a + segments);
+    }
+  }
+  mesh.faces.resize(3, faces.size());
+  for (size_t f = 0; f < faces.size(); ++f) mesh.faces.col(f) = faces[f];
   return mesh;
 }
 
