@@ -109,12 +109,14 @@ ReferenceColors ComputeModelReferenceColors(const Eigen::Matrix3Xd& vertices,
                                             const std::vector<std::vector<unsigned char>>& visible,
                                             double sigma_hat, OverlapForm form,
                                             double reach_sigmas) {
-  return ColorFromBestCameras(
+  ReferenceColors colors = ColorFromBestCameras(
       vertices, normals, cameras, visible, images.front().color_space(), sigma_hat,
       [&](int c, const ProjectedGaussian& projected, Eigen::Vector3f* color) {
         *color = ImageColorAround(images[c], projected, form, reach_sigmas).cast<float>();
         return true;
       });
+  colors.method = "image_model";
+  return colors;
 }
 
 void WriteReferenceColors(const std::string& path, const ReferenceColors& colors) {
@@ -125,6 +127,7 @@ void WriteReferenceColors(const std::string& path, const ReferenceColors& colors
       << "# the vertex in the reference frame.\n"
       << "color_space " << ColorSpaceName(colors.color_space) << "\n"
       << std::setprecision(9) << "sigma_hat " << colors.sigma_hat << "\n"
+      << "method " << colors.method << "\n"
       << "vertices " << colors.colors.size() << "\n";
   for (size_t v = 0; v < colors.colors.size(); ++v) {
     const Eigen::Vector3f& c = colors.colors[v];
@@ -149,6 +152,7 @@ ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertic
   read_header("color_space", &space_name);
   colors.color_space = ParseColorSpace(space_name, path);
   read_header("sigma_hat", &colors.sigma_hat);
+  read_header("method", &colors.method);
   read_header("vertices", &count);
   Require(count >= 0, path, "negative vertex count");
   Require(expected_vertices < 0 || count == expected_vertices, path,

@@ -34,6 +34,7 @@ struct SurfaceGaussians {
 struct ReferenceColors {
   ColorSpace color_space = ColorSpace::kHsv;
   double sigma_hat = 0.007;             // The footprint they were averaged over, metres.
+  std::string method = "pixels";        // How they were taken: "pixels" or "image_model".
   std::vector<Eigen::Vector3f> colors;  // One per mesh vertex.
   std::vector<unsigned char> valid;     // 1 where a camera saw the vertex.
 };

@@ -70,12 +70,14 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
     ReferenceColors saved = ReadReferenceColors(path, model.num_fine_vertices());
     const RefineOptions& options = config.refine;
     Require(saved.color_space == options.image.color_space &&
-                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-12 * options.sigma_hat,
+                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-12 * options.sigma_hat &&
+                saved.method == options.reference_colors,
             path,
-            "was made for colour space " + ColorSpaceName(saved.color_space) + " and sigma_hat " +
-                std::to_string(saved.sigma_hat) + ", but the config asks for " +
-                ColorSpaceName(options.image.color_space) + " and " +
-                std::to_string(options.sigma_hat) + ": use another output folder");
+            "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +
+                std::to_string(saved.sigma_hat) + " and method " + saved.method +
+                ", but the config asks for " + ColorSpaceName(options.image.color_space) + ", " +
+                std::to_string(options.sigma_hat) + " and " + options.reference_colors +
+                ": use another output folder");
     return saved;
   }
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
