@@ -148,6 +148,14 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                   "Write the input surface for a frame whose energy got worse (always flagged).");
   schema->AddBool("refine.warm_start", &refine->warm_start,
                   "Start each frame from the previous frame's displacement.");
+  schema->AddInt("refine.coarse_to_fine.levels", &refine->coarse_to_fine.levels,
+                 "Levels of a coarse-to-fine schedule per frame (wider Gaussians and a coarser "
+                 "image model first); 1: off.",
+                 1, 5);
+  schema->AddDouble("refine.coarse_to_fine.scale", &refine->coarse_to_fine.scale,
+                    "Factor of sigma_hat and of the smallest quad-tree leaf from one level to the "
+                    "next coarser.",
+                    1.0001, 4.0);
 }
 
 }  // namespace
