@@ -120,5 +120,26 @@ TEST(SolverTest, CeresAndLbfgsReachTheSameOptimum) {
   EXPECT_LT((k_ceres - k_lbfgs).cwiseAbs().maxCoeff(), 1e-4);
 }
 
+// Steps far too long for the energy overshoot every time; the ascent must still not return a k
+// below where it started.
+TEST(SolverTest, GradientAscentReturnsItsBestIterate) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.5}, 3, 41);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("surface_color", "printed"));
+  SolverOptions options;
+  options.type = "gradient_ascent";
+  options.initial_step = 0.01;
+  options.max_step = 0.01;
+  options.step_shrink = 0.99;
+  options.max_iterations = 5;
+  Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
+  const SolverSummary summary = Solve(&energy, options, &k);
+  double lowest = summary.trace.front().energy;
+  for (const SolverIteration& row : summary.trace) lowest = std::min(lowest, row.energy);
+  ASSERT_LT(lowest, summary.energy_start) << "the overshoot this test needs did not happen";
+  EXPECT_GE(summary.energy_end, summary.energy_start);
+  EXPECT_NE(summary.termination.find("best iterate"), std::string::npos) << summary.termination;
+}
+
 }  // namespace
 }  // namespace finecap

@@ -19,6 +19,10 @@ void SolveWithGradientAscent(const FrameEnergy& energy, const SolverOptions& opt
   summary->evaluations = 1;
   summary->trace.push_back({0, energy_value, clock.Seconds()});
   summary->termination = "max_iterations";
+  // On a non-smooth energy (the paper's min() clamp) a step can go downhill and the ascent end
+  // below where it has been: the best iterate is returned.
+  Eigen::VectorXd best_k = *k;
+  double best_energy = energy_value;
   for (int iteration = 1; iteration <= options.max_iterations; ++iteration) {
     if (factor.size() == 0) {
       const double largest = gradient.cwiseAbs().maxCoeff();
@@ -41,11 +45,19 @@ void SolveWithGradientAscent(const FrameEnergy& energy, const SolverOptions& opt
     ++summary->evaluations;
     summary->iterations = iteration;
     summary->trace.push_back({iteration, energy_value, clock.Seconds()});
+    if (energy_value > best_energy) {
+      best_energy = energy_value;
+      best_k = *k;
+    }
     const double change = std::abs(energy_value - previous_energy);
     if (change <= options.function_tolerance * std::max(std::abs(previous_energy), 1e-300)) {
       summary->termination = "function_tolerance";
       break;
     }
+  }
+  if (energy_value < best_energy) {
+    *k = best_k;
+    summary->termination += ", best iterate returned";
   }
   summary->seconds = clock.Seconds();
   summary->seconds_evaluation = summary->seconds;
