@@ -161,7 +161,15 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_GT(rms_coarse, 0.0);
   EXPECT_TRUE(std::isfinite(metrics["rms_refined_mm"].as<double>()));
   EXPECT_TRUE(std::isfinite(metrics["normal_error_coarse_deg"].as<double>()));
-  EXPECT_TRUE(metrics["flow_coarse_px"].IsNull());
+  // Optical flow needs no ground truth: finite figures, and the improvement from them.
+  const double flow_coarse = metrics["flow_coarse_px"].as<double>();
+  const double flow_refined = metrics["flow_refined_px"].as<double>();
+  EXPECT_TRUE(std::isfinite(flow_coarse));
+  EXPECT_GE(flow_coarse, 0.0);
+  EXPECT_TRUE(std::isfinite(flow_refined));
+  EXPECT_NEAR(metrics["flow_improvement_percent"].as<double>(),
+              100.0 * (flow_coarse - flow_refined) / flow_coarse, 1e-6);
+  EXPECT_TRUE(std::isfinite(metrics["frames"][0]["flow_refined_px"].as<double>()));
   EXPECT_EQ(metrics["frames"].size(), 3u);
   EXPECT_DOUBLE_EQ(metrics["sequence"]["all"]["rms_coarse_mm"].as<double>(), rms_coarse);
 
@@ -179,9 +187,15 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   }
   EXPECT_TRUE(IsPngOfSize(out + "/eval/rms.png", 800, 500));
   EXPECT_TRUE(IsPngOfSize(out + "/eval/normal_error.png", 800, 500));
+  EXPECT_TRUE(IsPngOfSize(out + "/eval/flow.png", 800, 500));
+  const std::string csv = FileBytes(out + "/eval/flow.csv");
+  EXPECT_EQ(csv.rfind("frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n000000,", 0),
+            0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
   const std::string report = FileBytes(out + "/eval/report.html");
   EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(report.find("detail recovered"), std::string::npos);
+  EXPECT_NE(report.find("flow refined px"), std::string::npos);
   EXPECT_EQ(testing_util::FilesIn(out + "/meshes"), refined_files);  // Nothing else touched.
 
   // The same run exported: one PC2 sample per frame holding the refined vertices.

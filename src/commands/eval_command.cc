@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/core.hpp>
@@ -12,6 +13,7 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/evaluation.h"
+#include "finecap/flow_evaluation.h"
 #include "finecap/html_report.h"
 #include "finecap/mesh_io.h"
 #include "finecap/plot.h"
@@ -38,18 +40,65 @@ cv::Mat SideBySidePicture(const cv::Mat& image, const Camera& camera, const Mesh
   return picture;
 }
 
+// What the optical-flow figures need, prepared once per run from the reference frame.
+struct FlowSetup {
+  OpticalFlowOptions options;
+  std::vector<int> cameras;  // The cameras the flow is measured in.
+  ProjectiveTexture texture;
+  std::vector<unsigned char> faces_to_measure;
+};
+
+// The texture of the reference frame's subdivided input mesh from its images (see
+// flow_evaluation.h for why not the saved reference colours), over the faces of refined vertices.
+FlowSetup PrepareFlow(const Config& config, const SequenceModel& model, Capture* capture) {
+  FlowSetup setup;
+  setup.options.method = config.eval.flow;
+  setup.options.dis_preset = config.eval.flow_dis_preset;
+  for (int c = 0; c < capture->num_cameras(); ++c) {
+    if (config.eval.flow_cameras == "all" || c == config.eval.camera) setup.cameras.push_back(c);
+  }
+  Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
+          "frame " + std::to_string(config.reference_frame) + " does not exist in " +
+              capture->directory());
+  const FrameInput reference = internal::ReadFrameInput(capture, config.reference_frame);
+  const Mesh fine = model.Subdivide(reference.coarse);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
+  setup.texture = MakeProjectiveTexture(
+      fine, normals, reference.cameras, reference.images,
+      ComputeFrameVisibility(fine, normals, reference.cameras, config.refine.visibility));
+  setup.faces_to_measure = FacesToMeasure(fine, setup.texture, model.refined_vertices());
+  return setup;
+}
+
+// The flow figures of one frame, the cameras' pixels pooled.
+FlowComparison MeasureFrameFlow(const FlowSetup& setup, int frame, const Mesh& input,
+                                const Mesh& refined, Capture* capture) {
+  FlowComparison frame_flow;
+  for (int c : setup.cameras) {
+    const Camera& camera = capture->cameras()[c];
+    frame_flow.Add(CompareFlow(camera, capture->ReadImage(c, frame), input, refined, setup.texture,
+                               setup.faces_to_measure, setup.options,
+                               capture->directory() + ": flow in camera " + camera.name +
+                                   ", frame " + capture->frame_name(frame)));
+  }
+  return frame_flow;
+}
+
 // What the sequence figures and the report collect while the frames are evaluated.
 struct EvaluationRun {
   std::vector<std::string> names;
   std::vector<double> frame_indices;
   std::vector<EvaluationFigures> figures;
+  std::vector<FlowComparison> flows;  // Per frame; empty sums when flow is not measured.
+  FlowComparison pooled_flow;
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
 
 void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
                    const SequenceModel& model, const std::vector<int>& textureless,
-                   const std::string& eval_dir, Capture* capture, EvaluationRun* run) {
+                   const FlowSetup* flow, const std::string& eval_dir, Capture* capture,
+                   EvaluationRun* run) {
   const Mesh coarse = capture->ReadCoarseMesh(frame.index);
   const Mesh input = model.Subdivide(coarse);
   const Mesh refined = ReadMesh(frame.mesh);
@@ -63,6 +112,9 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
   run->frame_indices.push_back(frame.index);
   run->figures.push_back(figures);
   run->pooled.Append(samples);
+  run->flows.push_back(flow ? MeasureFrameFlow(*flow, frame.index, input, refined, capture)
+                            : FlowComparison());
+  run->pooled_flow.Add(run->flows.back());
 
   const Camera& camera = capture->cameras()[config.eval.camera];
   const std::string picture = eval_dir + "/frame_" + frame.name + ".png";
@@ -107,6 +159,17 @@ std::string FiguresJson(const EvaluationFigures& figures) {
          ", \"textureless\": " + RegionJson(figures.textureless) + "}";
 }
 
+// The mean flow lengths of the input and the refined mesh and the improvement, as JSON members
+// (null when not measured).
+std::string FlowJson(const FlowComparison& flow, const std::string& separator) {
+  using internal::JsonNumber;
+  const double coarse = flow.coarse.mean_px();
+  const double refined = flow.refined.mean_px();
+  return "\"flow_coarse_px\": " + JsonNumber(coarse) + "," + separator +
+         "\"flow_refined_px\": " + JsonNumber(refined) + "," + separator +
+         "\"flow_improvement_percent\": " + JsonNumber(FlowImprovementPercent(coarse, refined));
+}
+
 // The headline figures (all refined vertices, the sequence pooled) at the top level, then the
 // regions of the sequence and of every frame.
 std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& sequence) {
@@ -118,12 +181,12 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
-       << ",\n  \"flow_coarse_px\": null,\n  \"flow_refined_px\": null"
-       << ",\n  \"flow_improvement_percent\": null"
+       << ",\n  " << FlowJson(run.pooled_flow, "\n  ")
        << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
   for (size_t i = 0; i < run.names.size(); ++i) {
     json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
-         << ", \"figures\": " << FiguresJson(run.figures[i]) << "}";
+         << ", " << FlowJson(run.flows[i], " ") << ", \"figures\": " << FiguresJson(run.figures[i])
+         << "}";
   }
   json << "\n  ]\n}\n";
   return json.str();
@@ -142,6 +205,26 @@ bool AnyFinite(const PlotSeries& series) {
     if (std::isfinite(y)) return true;
   }
   return false;
+}
+
+// The mean flow lengths of the input and the refined mesh over the frames (the paper's
+// Figure 6), when flow was measured; returns its path and caption.
+std::vector<std::pair<std::string, std::string>> WriteFlowPlot(const EvaluationRun& run,
+                                                               const std::string& eval_dir) {
+  PlotSeries input{"input", run.frame_indices, {}};
+  PlotSeries refined{"refined", run.frame_indices, {}};
+  for (const FlowComparison& flow : run.flows) {
+    input.y.push_back(flow.coarse.mean_px());
+    refined.y.push_back(flow.refined.mean_px());
+  }
+  if (!AnyFinite(input)) return {};
+  PlotOptions options;
+  options.x_label = "frame";
+  options.title = "Mean optical flow between the textured model's render and the image";
+  options.y_label = "pixels";
+  const std::string path = eval_dir + "/flow.png";
+  WriteLinePlot(path, {input, refined}, options);
+  return {{path, "Optical flow over the frames (the paper's Figure 6)"}};
 }
 
 // The two plots over the frames, when there is ground truth to plot; returns their paths.
@@ -184,6 +267,40 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
           region.normal_error_refined_deg};
 }
 
+std::vector<TableCell> FlowTableRow(const std::string& name, const FlowComparison& flow) {
+  const double coarse = flow.coarse.mean_px();
+  const double refined = flow.refined.mean_px();
+  return {name, coarse, refined, FlowImprovementPercent(coarse, refined)};
+}
+
+// The optical-flow figures: the sequence first, then every frame.
+void AddFlowTable(const EvaluationRun& run, HtmlReport* report) {
+  std::vector<std::vector<TableCell>> rows = {FlowTableRow("sequence", run.pooled_flow)};
+  for (size_t i = 0; i < run.names.size(); ++i)
+    rows.push_back(FlowTableRow(run.names[i], run.flows[i]));
+  report->AddParagraph(
+      "Mean length of the optical flow from a render of the model, textured from the reference "
+      "frame's images, to the input image, over the pixels where the model shows refined "
+      "vertices (no ground truth needed; the paper's section 7). Improvement: 100 (input - "
+      "refined) / input. n/a: not measured (eval.flow: none).");
+  report->AddTable({"", "flow input px", "flow refined px", "improvement %"}, rows,
+                   "Optical flow, the sequence pooled and per frame");
+}
+
+// eval/flow.csv: one line per frame, the figures of the flow table.
+void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n";
+  for (size_t i = 0; i < run.names.size(); ++i) {
+    const double coarse = run.flows[i].coarse.mean_px();
+    const double refined = run.flows[i].refined.mean_px();
+    csv << run.names[i] << ',' << coarse << ',' << refined << ','
+        << FlowImprovementPercent(coarse, refined) << '\n';
+  }
+  WriteTextFileAtomically(path, csv.str());
+}
+
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                  const std::vector<std::pair<std::string, std::string>>& plots,
                  const std::string& path) {
@@ -213,6 +330,7 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
     frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
   }
   report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  AddFlowTable(run, &report);
   if (!plots.empty()) report.AddSection("Over the frames");
   for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
   report.AddSection("Pictures");
@@ -236,15 +354,21 @@ int RunEval(const Config& config) {
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
   const std::vector<int> textureless = model.SubdivideIds(capture.textureless_vertices());
+  std::optional<FlowSetup> flow;
+  if (config.eval.flow != "none") flow = PrepareFlow(config, model, &capture);
   EvaluationRun run;
   internal::Progress progress(frames.size());
   for (const internal::RefinedFrame& frame : frames) {
-    EvaluateFrame(frame, config, model, textureless, eval_dir, &capture, &run);
+    EvaluateFrame(frame, config, model, textureless, flow ? &*flow : nullptr, eval_dir, &capture,
+                  &run);
     progress.FrameDone(frame.name, false, "");
   }
   const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
-  WriteReport(run, sequence, WritePlots(run, eval_dir), eval_dir + "/report.html");
+  WriteFlowCsv(run, eval_dir + "/flow.csv");
+  std::vector<std::pair<std::string, std::string>> plots = WritePlots(run, eval_dir);
+  for (const auto& plot : WriteFlowPlot(run, eval_dir)) plots.push_back(plot);
+  WriteReport(run, sequence, plots, eval_dir + "/report.html");
 
   std::cout.precision(3);
   std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
@@ -254,6 +378,12 @@ int RunEval(const Config& config) {
               << " mm; detail recovered " << 100.0 * sequence.all.detail_recovered
               << " %; normal error " << sequence.all.normal_error_coarse_deg << " -> "
               << sequence.all.normal_error_refined_deg << " degrees\n";
+  }
+  if (flow) {
+    const double coarse = run.pooled_flow.coarse.mean_px();
+    const double refined = run.pooled_flow.refined.mean_px();
+    std::cout << "Optical flow to the images: input " << coarse << " px, refined " << refined
+              << " px; improvement " << FlowImprovementPercent(coarse, refined) << " %\n";
   }
   return 0;
 }
