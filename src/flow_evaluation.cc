@@ -148,7 +148,8 @@ cv::Mat MeasuredPixels(const Camera& camera, const Mesh& mesh,
 FlowComparison CompareFlow(const Camera& camera, const cv::Mat& image, const Mesh& coarse,
                            const Mesh& refined, const ProjectiveTexture& texture,
                            const std::vector<unsigned char>& faces_to_measure,
-                           const OpticalFlowOptions& options, const std::string& where) {
+                           const OpticalFlowOptions& options, const std::string& where,
+                           FlowFields* fields) {
   Require(image.cols == camera.width && image.rows == camera.height, where,
           "the image is not of camera " + camera.name + "'s size");
   Require(static_cast<int>(faces_to_measure.size()) == coarse.num_faces() &&
@@ -156,16 +157,12 @@ FlowComparison CompareFlow(const Camera& camera, const cv::Mat& image, const Mes
           where, "the meshes and the faces to measure disagree in their face count");
   const cv::Mat mask = MeasuredPixels(camera, coarse, faces_to_measure) |
                        MeasuredPixels(camera, refined, faces_to_measure);
-  FlowComparison comparison;
-  comparison.coarse =
-      SumFlowMagnitude(ComputeOpticalFlow(RenderTexturedOverImage(camera, coarse, texture, image),
-                                          image, options, where),
-                       mask, where);
-  comparison.refined =
-      SumFlowMagnitude(ComputeOpticalFlow(RenderTexturedOverImage(camera, refined, texture, image),
-                                          image, options, where),
-                       mask, where);
-  return comparison;
+  const cv::Mat coarse_flow = ComputeOpticalFlow(
+      RenderTexturedOverImage(camera, coarse, texture, image), image, options, where);
+  const cv::Mat refined_flow = ComputeOpticalFlow(
+      RenderTexturedOverImage(camera, refined, texture, image), image, options, where);
+  if (fields) *fields = FlowFields{mask, coarse_flow, refined_flow};
+  return {SumFlowMagnitude(coarse_flow, mask, where), SumFlowMagnitude(refined_flow, mask, where)};
 }
 
 double FlowImprovementPercent(double coarse_px, double refined_px) {

@@ -70,14 +70,23 @@ struct FlowComparison {
   }
 };
 
+// The images behind one FlowComparison, for pictures.
+struct FlowFields {
+  cv::Mat mask;     // CV_8U, non-zero at the pixels measured.
+  cv::Mat coarse;   // CV_32FC2 flow from the input mesh's render to the image.
+  cv::Mat refined;  // CV_32FC2 flow from the refined mesh's render to the image.
+};
+
 // Renders `coarse` and `refined` (one topology, `texture` made for it) into `camera`, computes
 // the flow from each render to `image` (the camera's undistorted image of the same frame) and
 // sums its length over the same pixels for both: those where either mesh shows a face that
-// `faces_to_measure` marks. Throws Error(where, ...) when the image is not of the camera's size.
+// `faces_to_measure` marks. When `fields` is given it receives the mask and both flows. Throws
+// Error(where, ...) when the image is not of the camera's size.
 FlowComparison CompareFlow(const Camera& camera, const cv::Mat& image, const Mesh& coarse,
                            const Mesh& refined, const ProjectiveTexture& texture,
                            const std::vector<unsigned char>& faces_to_measure,
-                           const OpticalFlowOptions& options, const std::string& where);
+                           const OpticalFlowOptions& options, const std::string& where,
+                           FlowFields* fields = nullptr);
 
 // 100 (coarse - refined) / coarse, the paper's improvement in percent; NaN unless coarse is a
 // positive finite number.

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "commands/command_util.h"
 #include "finecap/atomic_file.h"
@@ -30,14 +31,57 @@ Eigen::VectorXd AbsoluteErrors(const EvaluationSamples& samples) {
   return (samples.k_refined - samples.k_true).cwiseAbs();
 }
 
-// Input image | normals of the input | normals of the refined mesh (the paper's Figure 4).
+// The part of the eval camera's view that shows the subject: the bounding box of both meshes'
+// footprints, widened by a margin; the whole view when neither is seen. A studio camera sees the
+// subject small, and uncropped pictures would show mostly background.
+cv::Rect SubjectBox(const Camera& camera, const Mesh& input, const Mesh& refined) {
+  const cv::Rect view(0, 0, camera.width, camera.height);
+  const cv::Mat seen = (RenderDepth(camera, input).triangle_ids >= 0) |
+                       (RenderDepth(camera, refined).triangle_ids >= 0);
+  const cv::Rect box = cv::boundingRect(seen);
+  if (box.empty()) return view;
+  const int margin = 8 + std::max(box.width, box.height) / 10;
+  return (box - cv::Point(margin, margin) + cv::Size(2 * margin, 2 * margin)) & view;
+}
+
+// Input image | normals of the input | normals of the refined mesh (the paper's Figure 4), all
+// cut to `box`.
 cv::Mat SideBySidePicture(const cv::Mat& image, const Camera& camera, const Mesh& input,
-                          const Mesh& refined) {
+                          const Mesh& refined, const cv::Rect& box) {
   cv::Mat picture;
-  cv::hconcat(
-      std::vector<cv::Mat>{image, RenderNormals(camera, input), RenderNormals(camera, refined)},
-      picture);
+  cv::hconcat(std::vector<cv::Mat>{image(box), RenderNormals(camera, input)(box),
+                                   RenderNormals(camera, refined)(box)},
+              picture);
   return picture;
+}
+
+// The length of `flow` in false colour (OpenCV's turbo map, blue 0 to dark red `max_px`) where
+// `mask` is set, and the image dimmed to grey elsewhere.
+cv::Mat FlowLengthPicture(const cv::Mat& flow, const cv::Mat& mask, const cv::Mat& image,
+                          double max_px) {
+  std::vector<cv::Mat> components;
+  cv::split(flow, components);
+  cv::Mat length, scaled, picture, grey;
+  cv::magnitude(components[0], components[1], length);
+  length.convertTo(scaled, CV_8U, 255.0 / max_px);
+  cv::applyColorMap(scaled, picture, cv::COLORMAP_TURBO);
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey / 2, grey, cv::COLOR_GRAY2BGR);
+  grey.copyTo(picture, mask == 0);
+  return picture;
+}
+
+// 95th percentile of the flow length over the mask; 1 px when there is none.
+double FlowLengthScale(const cv::Mat& flow, const cv::Mat& mask) {
+  std::vector<double> lengths;
+  for (int y = 0; y < flow.rows; ++y) {
+    for (int x = 0; x < flow.cols; ++x) {
+      const cv::Vec2f vector = flow.at<cv::Vec2f>(y, x);
+      if (mask.at<unsigned char>(y, x)) lengths.push_back(std::hypot(vector[0], vector[1]));
+    }
+  }
+  const double scale = Percentile(lengths, 95.0);
+  return scale > 0.0 ? scale : 1.0;
 }
 
 // What the optical-flow figures need, prepared once per run from the reference frame.
@@ -70,16 +114,19 @@ FlowSetup PrepareFlow(const Config& config, const SequenceModel& model, Capture*
   return setup;
 }
 
-// The flow figures of one frame, the cameras' pixels pooled.
+// The flow figures of one frame, the cameras' pixels pooled; `eval_fields` receives the flow
+// fields of camera `eval_camera`.
 FlowComparison MeasureFrameFlow(const FlowSetup& setup, int frame, const Mesh& input,
-                                const Mesh& refined, Capture* capture) {
+                                const Mesh& refined, int eval_camera, Capture* capture,
+                                FlowFields* eval_fields) {
   FlowComparison frame_flow;
   for (int c : setup.cameras) {
     const Camera& camera = capture->cameras()[c];
     frame_flow.Add(CompareFlow(camera, capture->ReadImage(c, frame), input, refined, setup.texture,
                                setup.faces_to_measure, setup.options,
                                capture->directory() + ": flow in camera " + camera.name +
-                                   ", frame " + capture->frame_name(frame)));
+                                   ", frame " + capture->frame_name(frame),
+                               c == eval_camera ? eval_fields : nullptr));
   }
   return frame_flow;
 }
@@ -112,26 +159,41 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
   run->frame_indices.push_back(frame.index);
   run->figures.push_back(figures);
   run->pooled.Append(samples);
-  run->flows.push_back(flow ? MeasureFrameFlow(*flow, frame.index, input, refined, capture)
+  FlowFields fields;
+  run->flows.push_back(flow ? MeasureFrameFlow(*flow, frame.index, input, refined,
+                                               config.eval.camera, capture, &fields)
                             : FlowComparison());
   run->pooled_flow.Add(run->flows.back());
-
   const Camera& camera = capture->cameras()[config.eval.camera];
+  const cv::Mat image = capture->ReadImage(config.eval.camera, frame.index);
+  const cv::Rect box = SubjectBox(camera, input, refined);
+  const std::string prefix = "Frame " + frame.name + ", camera " + camera.name + ": ";
   const std::string picture = eval_dir + "/frame_" + frame.name + ".png";
-  internal::WritePng(picture, SideBySidePicture(capture->ReadImage(config.eval.camera, frame.index),
-                                                camera, input, refined));
-  run->pictures.push_back({picture, "Frame " + frame.name + ", camera " + camera.name +
-                                        ": image, normals of the input, normals refined"});
+  internal::WritePng(picture, SideBySidePicture(image, camera, input, refined, box));
+  run->pictures.push_back({picture, prefix + "image, normals of the input, normals refined"});
+  std::ostringstream caption;
+  caption.precision(3);
+  if (!fields.mask.empty()) {
+    const double max_px = FlowLengthScale(fields.coarse, fields.mask);
+    cv::Mat both;
+    cv::hconcat(FlowLengthPicture(fields.coarse, fields.mask, image, max_px)(box),
+                FlowLengthPicture(fields.refined, fields.mask, image, max_px)(box), both);
+    const std::string flow_path = eval_dir + "/flow_" + frame.name + ".png";
+    internal::WritePng(flow_path, both);
+    caption << prefix << "optical flow length from the render of the input | of the refined mesh "
+            << "to the image, blue 0 to dark red " << max_px
+            << " px (95th percentile of the input's); grey: not measured";
+    run->pictures.push_back({flow_path, caption.str()});
+  }
   const double scale = figures.all.coarse.p95_abs;
   if (!(scale > 0.0)) return;  // No ground truth (or no detail): no error to colour.
   SurfaceAppearance heat;
   heat.vertex_colors = HeatMapColors(AbsoluteErrors(samples), scale);
   const std::string heat_path = eval_dir + "/error_" + frame.name + ".png";
-  internal::WritePng(heat_path, RenderColor(camera, refined, heat));
-  std::ostringstream caption;
-  caption.precision(3);
-  caption << "Frame " << frame.name << ": |k - k_true| on the refined mesh, blue 0 to dark red "
-          << 1000.0 * scale << " mm (95th percentile of the input's error); grey unknown";
+  internal::WritePng(heat_path, RenderColor(camera, refined, heat)(box));
+  caption.str("");
+  caption << prefix << "|k - k_true| on the refined mesh, blue 0 to dark red " << 1000.0 * scale
+          << " mm (95th percentile of the input's error); grey unknown";
   run->pictures.push_back({heat_path, caption.str()});
 }
 
@@ -303,6 +365,7 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
 
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                  const std::vector<std::pair<std::string, std::string>>& plots,
+                 const std::vector<std::pair<std::string, std::string>>& flow_plots,
                  const std::string& path) {
   const std::vector<std::string> header = {"",
                                            "vertices",
@@ -330,7 +393,9 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
     frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
   }
   report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  report.AddSection("Optical flow");
   AddFlowTable(run, &report);
+  for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
   if (!plots.empty()) report.AddSection("Over the frames");
   for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
   report.AddSection("Pictures");
@@ -366,9 +431,8 @@ int RunEval(const Config& config) {
   const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
   WriteFlowCsv(run, eval_dir + "/flow.csv");
-  std::vector<std::pair<std::string, std::string>> plots = WritePlots(run, eval_dir);
-  for (const auto& plot : WriteFlowPlot(run, eval_dir)) plots.push_back(plot);
-  WriteReport(run, sequence, plots, eval_dir + "/report.html");
+  WriteReport(run, sequence, WritePlots(run, eval_dir), WriteFlowPlot(run, eval_dir),
+              eval_dir + "/report.html");
 
   std::cout.precision(3);
   std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
