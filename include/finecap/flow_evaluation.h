@@ -59,6 +59,10 @@ std::vector<unsigned char> FacesToMeasure(const Mesh& mesh, const ProjectiveText
 cv::Mat RenderTexturedOverImage(const Camera& camera, const Mesh& mesh,
                                 const ProjectiveTexture& texture, const cv::Mat& image);
 
+// 100 (coarse - refined) / coarse, the paper's improvement in percent; NaN unless coarse is a
+// positive finite number.
+double FlowImprovementPercent(double coarse_px, double refined_px);
+
 // The flow figures of one camera and frame (or of many, added up).
 struct FlowComparison {
   FlowMagnitudeSum coarse;   // Input mesh render -> image.
@@ -67,6 +71,10 @@ struct FlowComparison {
   void Add(const FlowComparison& other) {
     coarse.Add(other.coarse);
     refined.Add(other.refined);
+  }
+  // FlowImprovementPercent of the two means.
+  double improvement_percent() const {
+    return FlowImprovementPercent(coarse.mean_px(), refined.mean_px());
   }
 };
 
@@ -87,10 +95,6 @@ FlowComparison CompareFlow(const Camera& camera, const cv::Mat& image, const Mes
                            const std::vector<unsigned char>& faces_to_measure,
                            const OpticalFlowOptions& options, const std::string& where,
                            FlowFields* fields = nullptr);
-
-// 100 (coarse - refined) / coarse, the paper's improvement in percent; NaN unless coarse is a
-// positive finite number.
-double FlowImprovementPercent(double coarse_px, double refined_px);
 
 }  // namespace finecap
 

@@ -84,6 +84,23 @@ double FlowLengthScale(const cv::Mat& flow, const cv::Mat& mask) {
   return scale > 0.0 ? scale : 1.0;
 }
 
+// Writes the flow length of the input | of the refined mesh, one scale for both, cut to `box`, to
+// `path`; returns its caption.
+std::string WriteFlowPicture(const FlowFields& fields, const cv::Mat& image, const cv::Rect& box,
+                             const std::string& path) {
+  const double max_px = FlowLengthScale(fields.coarse, fields.mask);
+  cv::Mat both;
+  cv::hconcat(FlowLengthPicture(fields.coarse, fields.mask, image, max_px)(box),
+              FlowLengthPicture(fields.refined, fields.mask, image, max_px)(box), both);
+  internal::WritePng(path, both);
+  std::ostringstream caption;
+  caption.precision(3);
+  caption << "optical flow length from the render of the input | of the refined mesh to the "
+          << "image, blue 0 to dark red " << max_px
+          << " px (95th percentile of the input's); grey: not measured";
+  return caption.str();
+}
+
 // What the optical-flow figures need, prepared once per run from the reference frame.
 struct FlowSetup {
   OpticalFlowOptions options;
@@ -171,19 +188,9 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
   const std::string picture = eval_dir + "/frame_" + frame.name + ".png";
   internal::WritePng(picture, SideBySidePicture(image, camera, input, refined, box));
   run->pictures.push_back({picture, prefix + "image, normals of the input, normals refined"});
-  std::ostringstream caption;
-  caption.precision(3);
   if (!fields.mask.empty()) {
-    const double max_px = FlowLengthScale(fields.coarse, fields.mask);
-    cv::Mat both;
-    cv::hconcat(FlowLengthPicture(fields.coarse, fields.mask, image, max_px)(box),
-                FlowLengthPicture(fields.refined, fields.mask, image, max_px)(box), both);
     const std::string flow_path = eval_dir + "/flow_" + frame.name + ".png";
-    internal::WritePng(flow_path, both);
-    caption << prefix << "optical flow length from the render of the input | of the refined mesh "
-            << "to the image, blue 0 to dark red " << max_px
-            << " px (95th percentile of the input's); grey: not measured";
-    run->pictures.push_back({flow_path, caption.str()});
+    run->pictures.push_back({flow_path, prefix + WriteFlowPicture(fields, image, box, flow_path)});
   }
   const double scale = figures.all.coarse.p95_abs;
   if (!(scale > 0.0)) return;  // No ground truth (or no detail): no error to colour.
@@ -191,7 +198,8 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
   heat.vertex_colors = HeatMapColors(AbsoluteErrors(samples), scale);
   const std::string heat_path = eval_dir + "/error_" + frame.name + ".png";
   internal::WritePng(heat_path, RenderColor(camera, refined, heat)(box));
-  caption.str("");
+  std::ostringstream caption;
+  caption.precision(3);
   caption << prefix << "|k - k_true| on the refined mesh, blue 0 to dark red " << 1000.0 * scale
           << " mm (95th percentile of the input's error); grey unknown";
   run->pictures.push_back({heat_path, caption.str()});
@@ -225,11 +233,9 @@ std::string FiguresJson(const EvaluationFigures& figures) {
 // (null when not measured).
 std::string FlowJson(const FlowComparison& flow, const std::string& separator) {
   using internal::JsonNumber;
-  const double coarse = flow.coarse.mean_px();
-  const double refined = flow.refined.mean_px();
-  return "\"flow_coarse_px\": " + JsonNumber(coarse) + "," + separator +
-         "\"flow_refined_px\": " + JsonNumber(refined) + "," + separator +
-         "\"flow_improvement_percent\": " + JsonNumber(FlowImprovementPercent(coarse, refined));
+  return "\"flow_coarse_px\": " + JsonNumber(flow.coarse.mean_px()) + "," + separator +
+         "\"flow_refined_px\": " + JsonNumber(flow.refined.mean_px()) + "," + separator +
+         "\"flow_improvement_percent\": " + JsonNumber(flow.improvement_percent());
 }
 
 // The headline figures (all refined vertices, the sequence pooled) at the top level, then the
@@ -330,16 +336,15 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
 }
 
 std::vector<TableCell> FlowTableRow(const std::string& name, const FlowComparison& flow) {
-  const double coarse = flow.coarse.mean_px();
-  const double refined = flow.refined.mean_px();
-  return {name, coarse, refined, FlowImprovementPercent(coarse, refined)};
+  return {name, flow.coarse.mean_px(), flow.refined.mean_px(), flow.improvement_percent()};
 }
 
 // The optical-flow figures: the sequence first, then every frame.
 void AddFlowTable(const EvaluationRun& run, HtmlReport* report) {
   std::vector<std::vector<TableCell>> rows = {FlowTableRow("sequence", run.pooled_flow)};
-  for (size_t i = 0; i < run.names.size(); ++i)
+  for (size_t i = 0; i < run.names.size(); ++i) {
     rows.push_back(FlowTableRow(run.names[i], run.flows[i]));
+  }
   report->AddParagraph(
       "Mean length of the optical flow from a render of the model, textured from the reference "
       "frame's images, to the input image, over the pixels where the model shows refined "
@@ -355,10 +360,9 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
   csv.precision(10);
   csv << "frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n";
   for (size_t i = 0; i < run.names.size(); ++i) {
-    const double coarse = run.flows[i].coarse.mean_px();
-    const double refined = run.flows[i].refined.mean_px();
-    csv << run.names[i] << ',' << coarse << ',' << refined << ','
-        << FlowImprovementPercent(coarse, refined) << '\n';
+    const FlowComparison& flow = run.flows[i];
+    csv << run.names[i] << ',' << flow.coarse.mean_px() << ',' << flow.refined.mean_px() << ','
+        << flow.improvement_percent() << '\n';
   }
   WriteTextFileAtomically(path, csv.str());
 }
@@ -444,10 +448,9 @@ int RunEval(const Config& config) {
               << sequence.all.normal_error_refined_deg << " degrees\n";
   }
   if (flow) {
-    const double coarse = run.pooled_flow.coarse.mean_px();
-    const double refined = run.pooled_flow.refined.mean_px();
-    std::cout << "Optical flow to the images: input " << coarse << " px, refined " << refined
-              << " px; improvement " << FlowImprovementPercent(coarse, refined) << " %\n";
+    std::cout << "Optical flow to the images: input " << run.pooled_flow.coarse.mean_px()
+              << " px, refined " << run.pooled_flow.refined.mean_px() << " px; improvement "
+              << run.pooled_flow.improvement_percent() << " %\n";
   }
   return 0;
 }
