@@ -146,38 +146,41 @@ Camera PinholeCamera(int size, double focal) {
   return camera;
 }
 
+// A 1 m plane at 2 m in front of a 128 x 128 camera (f = 100 px, so 50 px wide), textured from
+// a random image by that camera, which sees every vertex.
+struct TexturedPlane {
+  Camera camera = PinholeCamera(128, 100.0);
+  Mesh plane = FacingPlane(1.0, 2.0, 8);
+  cv::Mat image = RandomTexture(128, 128);
+  ProjectiveTexture texture =
+      MakeProjectiveTexture(plane, ComputeVertexNormals(plane), {camera}, {image},
+                            {std::vector<unsigned char>(plane.num_vertices(), 1)});
+};
+
 TEST(FlowEvaluationTest, TextureFromTheImageRendersTheImageBack) {
-  const Camera camera = PinholeCamera(128, 100.0);
-  const Mesh plane = FacingPlane(1.0, 2.0, 8);
-  const cv::Mat image = RandomTexture(128, 128);
-  const std::vector<std::vector<unsigned char>> seen = {
-      std::vector<unsigned char>(plane.num_vertices(), 1)};
-  const ProjectiveTexture texture =
-      MakeProjectiveTexture(plane, ComputeVertexNormals(plane), {camera}, {image}, seen);
-  EXPECT_EQ(texture.atlas.size(), image.size());
-  EXPECT_EQ(std::count(texture.textured.begin(), texture.textured.end(), 1), plane.num_faces());
+  const TexturedPlane scene;
+  const ProjectiveTexture& texture = scene.texture;
+  EXPECT_EQ(texture.atlas.size(), scene.image.size());
+  EXPECT_EQ(std::count(texture.textured.begin(), texture.textured.end(), 1),
+            scene.plane.num_faces());
   cv::Mat difference;
-  cv::absdiff(RenderTexturedOverImage(camera, plane, texture, image), image, difference);
+  cv::absdiff(RenderTexturedOverImage(scene.camera, scene.plane, texture, scene.image), scene.image,
+              difference);
   EXPECT_LE(cv::norm(difference, cv::NORM_INF), 2.0);  // Bilinear sampling at texel centres.
 }
 
 TEST(FlowEvaluationTest, APlaneMovedSidewaysFlowsByItsImageShift) {
   // Textured at x = 0, seen in a later "frame" whose image shows it unmoved: the input mesh is
   // 6 cm off to the side (3 px at 2 m with f = 100 px), the refined mesh is right.
-  const Camera camera = PinholeCamera(128, 100.0);
-  const Mesh plane = FacingPlane(1.0, 2.0, 8);
-  const cv::Mat image = RandomTexture(128, 128);
-  const std::vector<std::vector<unsigned char>> seen = {
-      std::vector<unsigned char>(plane.num_vertices(), 1)};
-  const ProjectiveTexture texture =
-      MakeProjectiveTexture(plane, ComputeVertexNormals(plane), {camera}, {image}, seen);
+  const TexturedPlane scene;
+  const Mesh& plane = scene.plane;
   Mesh moved = plane;
   moved.vertices.row(0).array() += 0.06;
   std::vector<int> all(plane.num_vertices());
   for (int v = 0; v < plane.num_vertices(); ++v) all[v] = v;
   const FlowComparison flow =
-      CompareFlow(camera, image, moved, plane, texture, FacesToMeasure(plane, texture, all),
-                  OpticalFlowOptions(), "plane");
+      CompareFlow(scene.camera, scene.image, moved, plane, scene.texture,
+                  FacesToMeasure(plane, scene.texture, all), OpticalFlowOptions(), "plane");
   // The union of both footprints is 53 px wide, 50 of which show the texture 3 px off.
   EXPECT_NEAR(flow.coarse.mean_px(), 3.0 * 50.0 / 53.0, 0.35);
   EXPECT_LT(flow.refined.mean_px(), 0.2);
