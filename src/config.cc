@@ -21,6 +21,17 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
                  "Worker threads for parallel stages; 0 = all cores.", 0, 1024);
   schema->AddInt("eval.camera", &config->eval.camera,
                  "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
+  schema->AddChoice("eval.flow", &config->eval.flow,
+                    "finecap eval: optical flow between the textured model's render and the "
+                    "image (the paper's section 7): dis, deepflow (slower) or none.",
+                    {"dis", "deepflow", "none"});
+  schema->AddChoice("eval.flow_dis_preset", &config->eval.flow_dis_preset,
+                    "finecap eval: preset of the DIS optical flow.",
+                    {"ultrafast", "fast", "medium"});
+  schema->AddChoice("eval.flow_cameras", &config->eval.flow_cameras,
+                    "finecap eval: cameras the flow is measured in, pixels pooled: all, or "
+                    "eval_camera (eval.camera only, as the paper's Figure 6).",
+                    {"all", "eval_camera"});
 }
 
 void AddModelKeys(Config* config, ConfigSchema* schema) {

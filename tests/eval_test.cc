@@ -161,7 +161,15 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_GT(rms_coarse, 0.0);
   EXPECT_TRUE(std::isfinite(metrics["rms_refined_mm"].as<double>()));
   EXPECT_TRUE(std::isfinite(metrics["normal_error_coarse_deg"].as<double>()));
-  EXPECT_TRUE(metrics["flow_coarse_px"].IsNull());
+  // Optical flow needs no ground truth: finite figures, and the improvement from them.
+  const double flow_coarse = metrics["flow_coarse_px"].as<double>();
+  const double flow_refined = metrics["flow_refined_px"].as<double>();
+  EXPECT_TRUE(std::isfinite(flow_coarse));
+  EXPECT_GE(flow_coarse, 0.0);
+  EXPECT_TRUE(std::isfinite(flow_refined));
+  EXPECT_NEAR(metrics["flow_improvement_percent"].as<double>(),
+              100.0 * (flow_coarse - flow_refined) / flow_coarse, 1e-6);
+  EXPECT_TRUE(std::isfinite(metrics["frames"][0]["flow_refined_px"].as<double>()));
   EXPECT_EQ(metrics["frames"].size(), 3u);
   EXPECT_DOUBLE_EQ(metrics["sequence"]["all"]["rms_coarse_mm"].as<double>(), rms_coarse);
 
@@ -174,15 +182,36 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
     EXPECT_NEAR(figures["rms_refined_mm"].as<double>(), stats["rms_refined_mm"].as<double>(), 1e-6);
   }
   for (const std::string frame : {"000000", "000001", "000002"}) {
-    EXPECT_TRUE(IsPngOfSize(out + "/eval/frame_" + frame + ".png", 3 * 96, 96)) << frame;
-    EXPECT_TRUE(IsPngOfSize(out + "/eval/error_" + frame + ".png", 96, 96)) << frame;
+    // Every picture is cut to the same box around the subject, inside the 96 x 96 view.
+    const cv::Mat error = cv::imread(out + "/eval/error_" + frame + ".png");
+    ASSERT_FALSE(error.empty()) << frame;
+    EXPECT_LE(error.cols, 96);
+    EXPECT_LE(error.rows, 96);
+    EXPECT_GT(error.cols, 16);
+    EXPECT_TRUE(IsPngOfSize(out + "/eval/frame_" + frame + ".png", 3 * error.cols, error.rows));
+    EXPECT_TRUE(IsPngOfSize(out + "/eval/flow_" + frame + ".png", 2 * error.cols, error.rows));
   }
   EXPECT_TRUE(IsPngOfSize(out + "/eval/rms.png", 800, 500));
   EXPECT_TRUE(IsPngOfSize(out + "/eval/normal_error.png", 800, 500));
+  EXPECT_TRUE(IsPngOfSize(out + "/eval/flow.png", 800, 500));
+  const std::string csv = FileBytes(out + "/eval/flow.csv");
+  EXPECT_EQ(csv.rfind("frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n000000,", 0),
+            0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
   const std::string report = FileBytes(out + "/eval/report.html");
   EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(report.find("detail recovered"), std::string::npos);
+  EXPECT_NE(report.find("flow refined px"), std::string::npos);
   EXPECT_EQ(testing_util::FilesIn(out + "/meshes"), refined_files);  // Nothing else touched.
+
+  // eval.flow: none leaves the flow figures out.
+  Config without_flow = config;
+  without_flow.eval.flow = "none";
+  ASSERT_EQ(RunEval(without_flow), 0);
+  const YAML::Node unmeasured = YAML::LoadFile(out + "/eval/metrics.json");
+  EXPECT_TRUE(unmeasured["flow_coarse_px"].IsNull());
+  EXPECT_TRUE(unmeasured["flow_improvement_percent"].IsNull());
+  EXPECT_TRUE(unmeasured["frames"][1]["flow_refined_px"].IsNull());
 
   // The same run exported: one PC2 sample per frame holding the refined vertices.
   ASSERT_EQ(RunExport(config), 0);

@@ -42,6 +42,15 @@ struct EvalConfig {
   // Index of the camera whose view the per-frame pictures show (0 = the first of the rig); must
   // be < the capture's camera count, which eval checks. Default 0.
   int camera = 0;
+  // The optical-flow figures (flow_evaluation.h): "dis" (OpenCV's DIS, default), "deepflow"
+  // (opencv_contrib's DeepFlow; slower) or "none" (not measured, null in metrics.json).
+  std::string flow = "dis";
+  // DIS preset: "ultrafast", "fast" or "medium" (default).
+  std::string flow_dis_preset = "medium";
+  // Cameras the flow is measured in: "all" (default; their pixels pooled, which averages out
+  // the view-dependence of a single camera) or "eval_camera" (only `camera`, as the paper's
+  // Figure 6 shows one view).
+  std::string flow_cameras = "all";
 };
 
 struct Config {

@@ -3,15 +3,18 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "commands/command_util.h"
 #include "finecap/atomic_file.h"
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/evaluation.h"
+#include "finecap/flow_evaluation.h"
 #include "finecap/html_report.h"
 #include "finecap/mesh_io.h"
 #include "finecap/plot.h"
@@ -28,14 +31,121 @@ Eigen::VectorXd AbsoluteErrors(const EvaluationSamples& samples) {
   return (samples.k_refined - samples.k_true).cwiseAbs();
 }
 
-// Input image | normals of the input | normals of the refined mesh (the paper's Figure 4).
+// The part of the eval camera's view that shows the subject: the bounding box of both meshes'
+// footprints, widened by a margin; the whole view when neither is seen. A studio camera sees the
+// subject small, and uncropped pictures would show mostly background.
+cv::Rect SubjectBox(const Camera& camera, const Mesh& input, const Mesh& refined) {
+  const cv::Rect view(0, 0, camera.width, camera.height);
+  const cv::Mat seen = (RenderDepth(camera, input).triangle_ids >= 0) |
+                       (RenderDepth(camera, refined).triangle_ids >= 0);
+  const cv::Rect box = cv::boundingRect(seen);
+  if (box.empty()) return view;
+  const int margin = 8 + std::max(box.width, box.height) / 10;
+  return (box - cv::Point(margin, margin) + cv::Size(2 * margin, 2 * margin)) & view;
+}
+
+// Input image | normals of the input | normals of the refined mesh (the paper's Figure 4), all
+// cut to `box`.
 cv::Mat SideBySidePicture(const cv::Mat& image, const Camera& camera, const Mesh& input,
-                          const Mesh& refined) {
+                          const Mesh& refined, const cv::Rect& box) {
   cv::Mat picture;
-  cv::hconcat(
-      std::vector<cv::Mat>{image, RenderNormals(camera, input), RenderNormals(camera, refined)},
-      picture);
+  cv::hconcat(std::vector<cv::Mat>{image(box), RenderNormals(camera, input)(box),
+                                   RenderNormals(camera, refined)(box)},
+              picture);
   return picture;
+}
+
+// The length of `flow` in false colour (OpenCV's turbo map, blue 0 to dark red `max_px`) where
+// `mask` is set, and the image dimmed to grey elsewhere.
+cv::Mat FlowLengthPicture(const cv::Mat& flow, const cv::Mat& mask, const cv::Mat& image,
+                          double max_px) {
+  std::vector<cv::Mat> components;
+  cv::split(flow, components);
+  cv::Mat length, scaled, picture, grey;
+  cv::magnitude(components[0], components[1], length);
+  length.convertTo(scaled, CV_8U, 255.0 / max_px);
+  cv::applyColorMap(scaled, picture, cv::COLORMAP_TURBO);
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(grey / 2, grey, cv::COLOR_GRAY2BGR);
+  grey.copyTo(picture, mask == 0);
+  return picture;
+}
+
+// 95th percentile of the flow length over the mask; 1 px when there is none.
+double FlowLengthScale(const cv::Mat& flow, const cv::Mat& mask) {
+  std::vector<double> lengths;
+  for (int y = 0; y < flow.rows; ++y) {
+    for (int x = 0; x < flow.cols; ++x) {
+      const cv::Vec2f vector = flow.at<cv::Vec2f>(y, x);
+      if (mask.at<unsigned char>(y, x)) lengths.push_back(std::hypot(vector[0], vector[1]));
+    }
+  }
+  const double scale = Percentile(lengths, 95.0);
+  return scale > 0.0 ? scale : 1.0;
+}
+
+// Writes the flow length of the input | of the refined mesh, one scale for both, cut to `box`, to
+// `path`; returns its caption.
+std::string WriteFlowPicture(const FlowFields& fields, const cv::Mat& image, const cv::Rect& box,
+                             const std::string& path) {
+  const double max_px = FlowLengthScale(fields.coarse, fields.mask);
+  cv::Mat both;
+  cv::hconcat(FlowLengthPicture(fields.coarse, fields.mask, image, max_px)(box),
+              FlowLengthPicture(fields.refined, fields.mask, image, max_px)(box), both);
+  internal::WritePng(path, both);
+  std::ostringstream caption;
+  caption.precision(3);
+  caption << "optical flow length from the render of the input | of the refined mesh to the "
+          << "image, blue 0 to dark red " << max_px
+          << " px (95th percentile of the input's); grey: not measured";
+  return caption.str();
+}
+
+// What the optical-flow figures need, prepared once per run from the reference frame.
+struct FlowSetup {
+  OpticalFlowOptions options;
+  std::vector<int> cameras;  // The cameras the flow is measured in.
+  ProjectiveTexture texture;
+  std::vector<unsigned char> faces_to_measure;
+};
+
+// The texture of the reference frame's subdivided input mesh from its images (see
+// flow_evaluation.h for why not the saved reference colours), over the faces of refined vertices.
+FlowSetup PrepareFlow(const Config& config, const SequenceModel& model, Capture* capture) {
+  FlowSetup setup;
+  setup.options.method = config.eval.flow;
+  setup.options.dis_preset = config.eval.flow_dis_preset;
+  for (int c = 0; c < capture->num_cameras(); ++c) {
+    if (config.eval.flow_cameras == "all" || c == config.eval.camera) setup.cameras.push_back(c);
+  }
+  Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
+          "frame " + std::to_string(config.reference_frame) + " does not exist in " +
+              capture->directory());
+  const FrameInput reference = internal::ReadFrameInput(capture, config.reference_frame);
+  const Mesh fine = model.Subdivide(reference.coarse);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
+  setup.texture = MakeProjectiveTexture(
+      fine, normals, reference.cameras, reference.images,
+      ComputeFrameVisibility(fine, normals, reference.cameras, config.refine.visibility));
+  setup.faces_to_measure = FacesToMeasure(fine, setup.texture, model.refined_vertices());
+  return setup;
+}
+
+// The flow figures of one frame, the cameras' pixels pooled; `eval_fields` receives the flow
+// fields of camera `eval_camera`.
+FlowComparison MeasureFrameFlow(const FlowSetup& setup, int frame, const Mesh& input,
+                                const Mesh& refined, int eval_camera, Capture* capture,
+                                FlowFields* eval_fields) {
+  FlowComparison frame_flow;
+  for (int c : setup.cameras) {
+    const Camera& camera = capture->cameras()[c];
+    frame_flow.Add(CompareFlow(camera, capture->ReadImage(c, frame), input, refined, setup.texture,
+                               setup.faces_to_measure, setup.options,
+                               capture->directory() + ": flow in camera " + camera.name +
+                                   ", frame " + capture->frame_name(frame),
+                               c == eval_camera ? eval_fields : nullptr));
+  }
+  return frame_flow;
 }
 
 // What the sequence figures and the report collect while the frames are evaluated.
@@ -43,13 +153,16 @@ struct EvaluationRun {
   std::vector<std::string> names;
   std::vector<double> frame_indices;
   std::vector<EvaluationFigures> figures;
+  std::vector<FlowComparison> flows;  // Per frame; empty sums when flow is not measured.
+  FlowComparison pooled_flow;
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
 
 void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
                    const SequenceModel& model, const std::vector<int>& textureless,
-                   const std::string& eval_dir, Capture* capture, EvaluationRun* run) {
+                   const FlowSetup* flow, const std::string& eval_dir, Capture* capture,
+                   EvaluationRun* run) {
   const Mesh coarse = capture->ReadCoarseMesh(frame.index);
   const Mesh input = model.Subdivide(coarse);
   const Mesh refined = ReadMesh(frame.mesh);
@@ -63,23 +176,32 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
   run->frame_indices.push_back(frame.index);
   run->figures.push_back(figures);
   run->pooled.Append(samples);
-
+  FlowFields fields;
+  run->flows.push_back(flow ? MeasureFrameFlow(*flow, frame.index, input, refined,
+                                               config.eval.camera, capture, &fields)
+                            : FlowComparison());
+  run->pooled_flow.Add(run->flows.back());
   const Camera& camera = capture->cameras()[config.eval.camera];
+  const cv::Mat image = capture->ReadImage(config.eval.camera, frame.index);
+  const cv::Rect box = SubjectBox(camera, input, refined);
+  const std::string prefix = "Frame " + frame.name + ", camera " + camera.name + ": ";
   const std::string picture = eval_dir + "/frame_" + frame.name + ".png";
-  internal::WritePng(picture, SideBySidePicture(capture->ReadImage(config.eval.camera, frame.index),
-                                                camera, input, refined));
-  run->pictures.push_back({picture, "Frame " + frame.name + ", camera " + camera.name +
-                                        ": image, normals of the input, normals refined"});
+  internal::WritePng(picture, SideBySidePicture(image, camera, input, refined, box));
+  run->pictures.push_back({picture, prefix + "image, normals of the input, normals refined"});
+  if (!fields.mask.empty()) {
+    const std::string flow_path = eval_dir + "/flow_" + frame.name + ".png";
+    run->pictures.push_back({flow_path, prefix + WriteFlowPicture(fields, image, box, flow_path)});
+  }
   const double scale = figures.all.coarse.p95_abs;
   if (!(scale > 0.0)) return;  // No ground truth (or no detail): no error to colour.
   SurfaceAppearance heat;
   heat.vertex_colors = HeatMapColors(AbsoluteErrors(samples), scale);
   const std::string heat_path = eval_dir + "/error_" + frame.name + ".png";
-  internal::WritePng(heat_path, RenderColor(camera, refined, heat));
+  internal::WritePng(heat_path, RenderColor(camera, refined, heat)(box));
   std::ostringstream caption;
   caption.precision(3);
-  caption << "Frame " << frame.name << ": |k - k_true| on the refined mesh, blue 0 to dark red "
-          << 1000.0 * scale << " mm (95th percentile of the input's error); grey unknown";
+  caption << prefix << "|k - k_true| on the refined mesh, blue 0 to dark red " << 1000.0 * scale
+          << " mm (95th percentile of the input's error); grey unknown";
   run->pictures.push_back({heat_path, caption.str()});
 }
 
@@ -107,6 +229,15 @@ std::string FiguresJson(const EvaluationFigures& figures) {
          ", \"textureless\": " + RegionJson(figures.textureless) + "}";
 }
 
+// The mean flow lengths of the input and the refined mesh and the improvement, as JSON members
+// (null when not measured).
+std::string FlowJson(const FlowComparison& flow, const std::string& separator) {
+  using internal::JsonNumber;
+  return "\"flow_coarse_px\": " + JsonNumber(flow.coarse.mean_px()) + "," + separator +
+         "\"flow_refined_px\": " + JsonNumber(flow.refined.mean_px()) + "," + separator +
+         "\"flow_improvement_percent\": " + JsonNumber(flow.improvement_percent());
+}
+
 // The headline figures (all refined vertices, the sequence pooled) at the top level, then the
 // regions of the sequence and of every frame.
 std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& sequence) {
@@ -118,12 +249,12 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
-       << ",\n  \"flow_coarse_px\": null,\n  \"flow_refined_px\": null"
-       << ",\n  \"flow_improvement_percent\": null"
+       << ",\n  " << FlowJson(run.pooled_flow, "\n  ")
        << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
   for (size_t i = 0; i < run.names.size(); ++i) {
     json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
-         << ", \"figures\": " << FiguresJson(run.figures[i]) << "}";
+         << ", " << FlowJson(run.flows[i], " ") << ", \"figures\": " << FiguresJson(run.figures[i])
+         << "}";
   }
   json << "\n  ]\n}\n";
   return json.str();
@@ -142,6 +273,26 @@ bool AnyFinite(const PlotSeries& series) {
     if (std::isfinite(y)) return true;
   }
   return false;
+}
+
+// The mean flow lengths of the input and the refined mesh over the frames (the paper's
+// Figure 6), when flow was measured; returns its path and caption.
+std::vector<std::pair<std::string, std::string>> WriteFlowPlot(const EvaluationRun& run,
+                                                               const std::string& eval_dir) {
+  PlotSeries input{"input", run.frame_indices, {}};
+  PlotSeries refined{"refined", run.frame_indices, {}};
+  for (const FlowComparison& flow : run.flows) {
+    input.y.push_back(flow.coarse.mean_px());
+    refined.y.push_back(flow.refined.mean_px());
+  }
+  if (!AnyFinite(input)) return {};
+  PlotOptions options;
+  options.x_label = "frame";
+  options.title = "Mean optical flow between the textured model's render and the image";
+  options.y_label = "pixels";
+  const std::string path = eval_dir + "/flow.png";
+  WriteLinePlot(path, {input, refined}, options);
+  return {{path, "Optical flow over the frames (the paper's Figure 6)"}};
 }
 
 // The two plots over the frames, when there is ground truth to plot; returns their paths.
@@ -184,8 +335,41 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
           region.normal_error_refined_deg};
 }
 
+std::vector<TableCell> FlowTableRow(const std::string& name, const FlowComparison& flow) {
+  return {name, flow.coarse.mean_px(), flow.refined.mean_px(), flow.improvement_percent()};
+}
+
+// The optical-flow figures: the sequence first, then every frame.
+void AddFlowTable(const EvaluationRun& run, HtmlReport* report) {
+  std::vector<std::vector<TableCell>> rows = {FlowTableRow("sequence", run.pooled_flow)};
+  for (size_t i = 0; i < run.names.size(); ++i) {
+    rows.push_back(FlowTableRow(run.names[i], run.flows[i]));
+  }
+  report->AddParagraph(
+      "Mean length of the optical flow from a render of the model, textured from the reference "
+      "frame's images, to the input image, over the pixels where the model shows refined "
+      "vertices (no ground truth needed; the paper's section 7). Improvement: 100 (input - "
+      "refined) / input. n/a: not measured (eval.flow: none).");
+  report->AddTable({"", "flow input px", "flow refined px", "improvement %"}, rows,
+                   "Optical flow, the sequence pooled and per frame");
+}
+
+// eval/flow.csv: one line per frame, the figures of the flow table.
+void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n";
+  for (size_t i = 0; i < run.names.size(); ++i) {
+    const FlowComparison& flow = run.flows[i];
+    csv << run.names[i] << ',' << flow.coarse.mean_px() << ',' << flow.refined.mean_px() << ','
+        << flow.improvement_percent() << '\n';
+  }
+  WriteTextFileAtomically(path, csv.str());
+}
+
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                  const std::vector<std::pair<std::string, std::string>>& plots,
+                 const std::vector<std::pair<std::string, std::string>>& flow_plots,
                  const std::string& path) {
   const std::vector<std::string> header = {"",
                                            "vertices",
@@ -213,6 +397,9 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
     frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
   }
   report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  report.AddSection("Optical flow");
+  AddFlowTable(run, &report);
+  for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
   if (!plots.empty()) report.AddSection("Over the frames");
   for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
   report.AddSection("Pictures");
@@ -236,15 +423,20 @@ int RunEval(const Config& config) {
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
   const std::vector<int> textureless = model.SubdivideIds(capture.textureless_vertices());
+  std::optional<FlowSetup> flow;
+  if (config.eval.flow != "none") flow = PrepareFlow(config, model, &capture);
   EvaluationRun run;
   internal::Progress progress(frames.size());
   for (const internal::RefinedFrame& frame : frames) {
-    EvaluateFrame(frame, config, model, textureless, eval_dir, &capture, &run);
+    EvaluateFrame(frame, config, model, textureless, flow ? &*flow : nullptr, eval_dir, &capture,
+                  &run);
     progress.FrameDone(frame.name, false, "");
   }
   const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
-  WriteReport(run, sequence, WritePlots(run, eval_dir), eval_dir + "/report.html");
+  WriteFlowCsv(run, eval_dir + "/flow.csv");
+  WriteReport(run, sequence, WritePlots(run, eval_dir), WriteFlowPlot(run, eval_dir),
+              eval_dir + "/report.html");
 
   std::cout.precision(3);
   std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
@@ -254,6 +446,11 @@ int RunEval(const Config& config) {
               << " mm; detail recovered " << 100.0 * sequence.all.detail_recovered
               << " %; normal error " << sequence.all.normal_error_coarse_deg << " -> "
               << sequence.all.normal_error_refined_deg << " degrees\n";
+  }
+  if (flow) {
+    std::cout << "Optical flow to the images: input " << run.pooled_flow.coarse.mean_px()
+              << " px, refined " << run.pooled_flow.refined.mean_px() << " px; improvement "
+              << run.pooled_flow.improvement_percent() << " %\n";
   }
   return 0;
 }
