@@ -1,0 +1,237 @@
+#include "finecap/comparison.h"
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "finecap/error.h"
+#include "finecap/metrics.h"
+
+namespace finecap {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+YAML::Node Field(const YAML::Node& record, const char* name, const std::string& path) {
+  const YAML::Node value = record[name];
+  Require(value.IsDefined(), path, std::string("the record has no field '") + name + "'");
+  return value;
+}
+
+double NumberField(const YAML::Node& record, const char* name, const std::string& path) {
+  const YAML::Node value = Field(record, name, path);
+  if (value.IsNull()) return kNaN;  // Written for a non-finite number.
+  try {
+    return value.as<double>();
+  } catch (const YAML::Exception&) {
+    throw Error(path, std::string("field '") + name + "' is not a number");
+  }
+}
+
+std::string TextField(const YAML::Node& record, const char* name, const std::string& path) {
+  const YAML::Node value = Field(record, name, path);
+  Require(value.IsScalar(), path, std::string("field '") + name + "' is not text");
+  return value.Scalar();
+}
+
+bool BoolField(const YAML::Node& record, const char* name, const std::string& path) {
+  try {
+    return Field(record, name, path).as<bool>();
+  } catch (const YAML::Exception&) {
+    throw Error(path, std::string("field '") + name + "' is not true or false");
+  }
+}
+
+double Mean(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double value : values) sum += value;
+  return sum / values.size();
+}
+
+double RootMeanSquare(const std::vector<double>& values) {
+  double sum = 0.0;
+  for (double value : values) sum += value * value;
+  return std::sqrt(sum / values.size());
+}
+
+template <typename Field>
+std::vector<double> Column(const std::vector<FrameStats>& frames, Field field) {
+  std::vector<double> values;
+  for (const FrameStats& stats : frames) values.push_back(field(stats));
+  return values;
+}
+
+// The numeric columns of every table, in order: CSV name, heading with unit, value.
+struct NumberColumn {
+  const char* csv;
+  const char* heading;
+  double (*value)(const VariantSummary&);
+};
+
+const std::vector<NumberColumn>& NumberColumns() {
+  static const std::vector<NumberColumn> kColumns = {
+      {"frames", "frames", [](const VariantSummary& r) { return double(r.frames); }},
+      {"energy_end", "E reached (own energy)",
+       [](const VariantSummary& r) { return r.energy_end; }},
+      {"paper_e_sim", "paper's E_sim at result",
+       [](const VariantSummary& r) { return r.paper_similarity; }},
+      {"ls_cost_end", "LS cost", [](const VariantSummary& r) { return r.ls_cost_end; }},
+      {"rms_input_mm", "RMS input mm", [](const VariantSummary& r) { return r.rms_input_mm; }},
+      {"rms_textured_mm", "RMS textured mm",
+       [](const VariantSummary& r) { return r.rms_textured_mm; }},
+      {"rms_textureless_mm", "RMS textureless mm",
+       [](const VariantSummary& r) { return r.rms_textureless_mm; }},
+      {"detail_recovered_percent", "detail recovered %",
+       [](const VariantSummary& r) { return 100.0 * r.detail_recovered; }},
+      {"iterations", "iterations", [](const VariantSummary& r) { return r.iterations; }},
+      {"evaluations", "evaluations", [](const VariantSummary& r) { return r.evaluations; }},
+      {"seconds_per_frame", "s/frame", [](const VariantSummary& r) { return r.seconds_per_frame; }},
+      {"seconds_solve", "solve s", [](const VariantSummary& r) { return r.seconds_solve; }},
+      {"seconds_evaluation", "evaluation s",
+       [](const VariantSummary& r) { return r.seconds_evaluation; }},
+      {"seconds_linear_solver", "linear solver s",
+       [](const VariantSummary& r) { return r.seconds_linear_solver; }},
+      {"time_ratio", "time ratio", [](const VariantSummary& r) { return r.time_ratio; }},
+  };
+  return kColumns;
+}
+
+}  // namespace
+
+FrameStats ReadFrameStats(const std::string& path) {
+  YAML::Node record;
+  try {
+    record = YAML::LoadFile(path);  // JSON is YAML.
+  } catch (const YAML::BadFile&) {
+    throw Error(path, "cannot open the statistics record");
+  } catch (const YAML::Exception& error) {
+    throw Error(path, "malformed statistics record: " + error.msg);
+  }
+  Require(record.IsMap(), path, "a statistics record is one JSON object");
+  FrameStats stats;
+  stats.frame = TextField(record, "frame", path);
+  stats.solver = TextField(record, "solver", path);
+  stats.similarity = TextField(record, "similarity", path);
+  stats.energy_start = NumberField(record, "energy_start", path);
+  stats.energy_end = NumberField(record, "energy_end", path);
+  stats.ls_cost_start = NumberField(record, "ls_cost_start", path);
+  stats.ls_cost_end = NumberField(record, "ls_cost_end", path);
+  stats.iterations = static_cast<int>(NumberField(record, "iterations", path));
+  stats.evaluations = static_cast<int>(NumberField(record, "evaluations", path));
+  stats.seconds = NumberField(record, "seconds", path);
+  stats.seconds_solve = NumberField(record, "seconds_solve", path);
+  stats.seconds_evaluation = NumberField(record, "seconds_evaluation", path);
+  stats.seconds_linear_solver = NumberField(record, "seconds_linear_solver", path);
+  stats.worse = BoolField(record, "worse", path);
+  stats.kept_input = BoolField(record, "kept_input", path);
+  stats.rms_coarse_mm = NumberField(record, "rms_coarse_mm", path);
+  stats.rms_refined_mm = NumberField(record, "rms_refined_mm", path);
+  stats.rms_textureless_refined_mm = NumberField(record, "rms_textureless_refined_mm", path);
+  return stats;
+}
+
+VariantSummary SummarizeVariant(const std::string& name, const std::vector<FrameStats>& frames,
+                                const std::vector<double>& paper_similarity) {
+  Require(!frames.empty(), name, "no refined frame to summarise");
+  Require(paper_similarity.size() == frames.size(), name,
+          "one paper E_sim per frame expected, got " + std::to_string(paper_similarity.size()));
+  VariantSummary row;
+  row.name = name;
+  row.solver = frames.front().solver;
+  row.similarity = frames.front().similarity;
+  row.frames = static_cast<int>(frames.size());
+  row.energy_end = Mean(Column(frames, [](const FrameStats& s) { return s.energy_end; }));
+  row.paper_similarity = Mean(paper_similarity);
+  row.ls_cost_end = Mean(Column(frames, [](const FrameStats& s) { return s.ls_cost_end; }));
+  row.rms_input_mm =
+      RootMeanSquare(Column(frames, [](const FrameStats& s) { return s.rms_coarse_mm; }));
+  row.rms_textured_mm =
+      RootMeanSquare(Column(frames, [](const FrameStats& s) { return s.rms_refined_mm; }));
+  row.rms_textureless_mm = RootMeanSquare(
+      Column(frames, [](const FrameStats& s) { return s.rms_textureless_refined_mm; }));
+  row.detail_recovered = DetailRecovered(row.rms_textured_mm, row.rms_input_mm);
+  row.iterations = Mean(Column(frames, [](const FrameStats& s) { return double(s.iterations); }));
+  row.evaluations = Mean(Column(frames, [](const FrameStats& s) { return double(s.evaluations); }));
+  row.seconds_per_frame =
+      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds; }), 50);
+  row.seconds_solve =
+      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_solve; }), 50);
+  row.seconds_evaluation =
+      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_evaluation; }), 50);
+  row.seconds_linear_solver =
+      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_linear_solver; }), 50);
+  return row;
+}
+
+int ReferenceVariant(const std::vector<VariantSummary>& rows, const std::string& reference) {
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (reference.empty() ? rows[i].solver == "gradient_ascent" : rows[i].name == reference) {
+      return static_cast<int>(i);
+    }
+  }
+  Require(reference.empty(), "compare.reference", "'" + reference + "' is not a variant");
+  return 0;
+}
+
+void SetTimeRatios(int reference, std::vector<VariantSummary>* rows) {
+  const double base = rows->at(reference).seconds_per_frame;
+  for (VariantSummary& row : *rows) row.time_ratio = row.seconds_per_frame / base;
+}
+
+std::string ComparisonCsv(const std::vector<VariantSummary>& rows) {
+  std::ostringstream csv;
+  csv << "variant,solver,similarity";
+  for (const NumberColumn& column : NumberColumns()) csv << "," << column.csv;
+  csv << "\n";
+  csv.precision(10);
+  for (const VariantSummary& row : rows) {
+    csv << row.name << "," << row.solver << "," << row.similarity;
+    for (const NumberColumn& column : NumberColumns()) {
+      const double value = column.value(row);
+      csv << ",";
+      if (std::isfinite(value)) {
+        csv << value;
+      } else {
+        csv << "nan";
+      }
+    }
+    csv << "\n";
+  }
+  return csv.str();
+}
+
+std::vector<std::string> ComparisonTableHeader() {
+  std::vector<std::string> header = {"variant", "solver", "similarity"};
+  for (const NumberColumn& column : NumberColumns()) header.push_back(column.heading);
+  return header;
+}
+
+std::vector<std::vector<TableCell>> ComparisonTableRows(const std::vector<VariantSummary>& rows) {
+  std::vector<std::vector<TableCell>> cells;
+  for (const VariantSummary& row : rows) {
+    std::vector<TableCell> line = {row.name, row.solver, row.similarity};
+    for (const NumberColumn& column : NumberColumns()) line.push_back(column.value(row));
+    cells.push_back(line);
+  }
+  return cells;
+}
+
+std::string ComparisonMarkdown(const std::vector<VariantSummary>& rows) {
+  std::ostringstream text;
+  const std::vector<std::string> header = ComparisonTableHeader();
+  std::string rule = "|";
+  for (const std::string& heading : header) {
+    text << "| " << heading << " ";
+    rule += "---|";
+  }
+  text << "|\n" << rule << "\n";
+  for (const std::vector<TableCell>& line : ComparisonTableRows(rows)) {
+    for (const TableCell& cell : line) text << "| " << cell.text() << " ";
+    text << "|\n";
+  }
+  return text.str();
+}
+
+}  // namespace finecap
