@@ -56,46 +56,48 @@ double RootMeanSquare(const std::vector<double>& values) {
   return std::sqrt(sum / values.size());
 }
 
-template <typename Field>
-std::vector<double> Column(const std::vector<FrameStats>& frames, Field field) {
+// One number of every record, as double.
+template <typename Number>
+std::vector<double> Column(const std::vector<FrameStats>& frames, Number FrameStats::*field) {
   std::vector<double> values;
-  for (const FrameStats& stats : frames) values.push_back(field(stats));
+  for (const FrameStats& stats : frames) values.push_back(static_cast<double>(stats.*field));
   return values;
 }
 
-// The numeric columns of every table, in order: CSV name, heading with unit, value.
+double Median(const std::vector<double>& values) { return Percentile(values, 50.0); }
+
+// The numeric columns of every table after variant, solver, similarity and frames, in order:
+// CSV name, heading with unit, field and the factor it is shown with.
 struct NumberColumn {
   const char* csv;
   const char* heading;
-  double (*value)(const VariantSummary&);
+  double VariantSummary::*field;
+  double scale;
 };
 
 const std::vector<NumberColumn>& NumberColumns() {
+  using V = VariantSummary;
   static const std::vector<NumberColumn> kColumns = {
-      {"frames", "frames", [](const VariantSummary& r) { return double(r.frames); }},
-      {"energy_end", "E reached (own energy)",
-       [](const VariantSummary& r) { return r.energy_end; }},
-      {"paper_e_sim", "paper's E_sim at result",
-       [](const VariantSummary& r) { return r.paper_similarity; }},
-      {"ls_cost_end", "LS cost", [](const VariantSummary& r) { return r.ls_cost_end; }},
-      {"rms_input_mm", "RMS input mm", [](const VariantSummary& r) { return r.rms_input_mm; }},
-      {"rms_textured_mm", "RMS textured mm",
-       [](const VariantSummary& r) { return r.rms_textured_mm; }},
-      {"rms_textureless_mm", "RMS textureless mm",
-       [](const VariantSummary& r) { return r.rms_textureless_mm; }},
-      {"detail_recovered_percent", "detail recovered %",
-       [](const VariantSummary& r) { return 100.0 * r.detail_recovered; }},
-      {"iterations", "iterations", [](const VariantSummary& r) { return r.iterations; }},
-      {"evaluations", "evaluations", [](const VariantSummary& r) { return r.evaluations; }},
-      {"seconds_per_frame", "s/frame", [](const VariantSummary& r) { return r.seconds_per_frame; }},
-      {"seconds_solve", "solve s", [](const VariantSummary& r) { return r.seconds_solve; }},
-      {"seconds_evaluation", "evaluation s",
-       [](const VariantSummary& r) { return r.seconds_evaluation; }},
-      {"seconds_linear_solver", "linear solver s",
-       [](const VariantSummary& r) { return r.seconds_linear_solver; }},
-      {"time_ratio", "time ratio", [](const VariantSummary& r) { return r.time_ratio; }},
+      {"energy_end", "E reached (own energy)", &V::energy_end, 1.0},
+      {"paper_e_sim", "paper's E_sim at result", &V::paper_similarity, 1.0},
+      {"ls_cost_end", "LS cost", &V::ls_cost_end, 1.0},
+      {"rms_input_mm", "RMS input mm", &V::rms_input_mm, 1.0},
+      {"rms_textured_mm", "RMS textured mm", &V::rms_textured_mm, 1.0},
+      {"rms_textureless_mm", "RMS textureless mm", &V::rms_textureless_mm, 1.0},
+      {"detail_recovered_percent", "detail recovered %", &V::detail_recovered, 100.0},
+      {"iterations", "iterations", &V::iterations, 1.0},
+      {"evaluations", "evaluations", &V::evaluations, 1.0},
+      {"seconds_per_frame", "s/frame", &V::seconds_per_frame, 1.0},
+      {"seconds_solve", "solve s", &V::seconds_solve, 1.0},
+      {"seconds_evaluation", "evaluation s", &V::seconds_evaluation, 1.0},
+      {"seconds_linear_solver", "linear solver s", &V::seconds_linear_solver, 1.0},
+      {"time_ratio", "time ratio", &V::time_ratio, 1.0},
   };
   return kColumns;
+}
+
+double Value(const NumberColumn& column, const VariantSummary& row) {
+  return column.scale * (row.*column.field);
 }
 
 }  // namespace
@@ -142,26 +144,19 @@ VariantSummary SummarizeVariant(const std::string& name, const std::vector<Frame
   row.solver = frames.front().solver;
   row.similarity = frames.front().similarity;
   row.frames = static_cast<int>(frames.size());
-  row.energy_end = Mean(Column(frames, [](const FrameStats& s) { return s.energy_end; }));
+  row.energy_end = Mean(Column(frames, &FrameStats::energy_end));
   row.paper_similarity = Mean(paper_similarity);
-  row.ls_cost_end = Mean(Column(frames, [](const FrameStats& s) { return s.ls_cost_end; }));
-  row.rms_input_mm =
-      RootMeanSquare(Column(frames, [](const FrameStats& s) { return s.rms_coarse_mm; }));
-  row.rms_textured_mm =
-      RootMeanSquare(Column(frames, [](const FrameStats& s) { return s.rms_refined_mm; }));
-  row.rms_textureless_mm = RootMeanSquare(
-      Column(frames, [](const FrameStats& s) { return s.rms_textureless_refined_mm; }));
+  row.ls_cost_end = Mean(Column(frames, &FrameStats::ls_cost_end));
+  row.rms_input_mm = RootMeanSquare(Column(frames, &FrameStats::rms_coarse_mm));
+  row.rms_textured_mm = RootMeanSquare(Column(frames, &FrameStats::rms_refined_mm));
+  row.rms_textureless_mm = RootMeanSquare(Column(frames, &FrameStats::rms_textureless_refined_mm));
   row.detail_recovered = DetailRecovered(row.rms_textured_mm, row.rms_input_mm);
-  row.iterations = Mean(Column(frames, [](const FrameStats& s) { return double(s.iterations); }));
-  row.evaluations = Mean(Column(frames, [](const FrameStats& s) { return double(s.evaluations); }));
-  row.seconds_per_frame =
-      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds; }), 50);
-  row.seconds_solve =
-      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_solve; }), 50);
-  row.seconds_evaluation =
-      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_evaluation; }), 50);
-  row.seconds_linear_solver =
-      Percentile(Column(frames, [](const FrameStats& s) { return s.seconds_linear_solver; }), 50);
+  row.iterations = Mean(Column(frames, &FrameStats::iterations));
+  row.evaluations = Mean(Column(frames, &FrameStats::evaluations));
+  row.seconds_per_frame = Median(Column(frames, &FrameStats::seconds));
+  row.seconds_solve = Median(Column(frames, &FrameStats::seconds_solve));
+  row.seconds_evaluation = Median(Column(frames, &FrameStats::seconds_evaluation));
+  row.seconds_linear_solver = Median(Column(frames, &FrameStats::seconds_linear_solver));
   return row;
 }
 
@@ -182,14 +177,14 @@ void SetTimeRatios(int reference, std::vector<VariantSummary>* rows) {
 
 std::string ComparisonCsv(const std::vector<VariantSummary>& rows) {
   std::ostringstream csv;
-  csv << "variant,solver,similarity";
+  csv << "variant,solver,similarity,frames";
   for (const NumberColumn& column : NumberColumns()) csv << "," << column.csv;
   csv << "\n";
   csv.precision(10);
   for (const VariantSummary& row : rows) {
-    csv << row.name << "," << row.solver << "," << row.similarity;
+    csv << row.name << "," << row.solver << "," << row.similarity << "," << row.frames;
     for (const NumberColumn& column : NumberColumns()) {
-      const double value = column.value(row);
+      const double value = Value(column, row);
       csv << ",";
       if (std::isfinite(value)) {
         csv << value;
@@ -203,7 +198,7 @@ std::string ComparisonCsv(const std::vector<VariantSummary>& rows) {
 }
 
 std::vector<std::string> ComparisonTableHeader() {
-  std::vector<std::string> header = {"variant", "solver", "similarity"};
+  std::vector<std::string> header = {"variant", "solver", "similarity", "frames"};
   for (const NumberColumn& column : NumberColumns()) header.push_back(column.heading);
   return header;
 }
@@ -211,8 +206,8 @@ std::vector<std::string> ComparisonTableHeader() {
 std::vector<std::vector<TableCell>> ComparisonTableRows(const std::vector<VariantSummary>& rows) {
   std::vector<std::vector<TableCell>> cells;
   for (const VariantSummary& row : rows) {
-    std::vector<TableCell> line = {row.name, row.solver, row.similarity};
-    for (const NumberColumn& column : NumberColumns()) line.push_back(column.value(row));
+    std::vector<TableCell> line = {row.name, row.solver, row.similarity, row.frames};
+    for (const NumberColumn& column : NumberColumns()) line.push_back(Value(column, row));
     cells.push_back(line);
   }
   return cells;

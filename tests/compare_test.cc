@@ -141,6 +141,25 @@ TEST(ComparisonTest, SummaryMatchesAHandComputation) {
   EXPECT_NE(markdown.find("| n/a |"), std::string::npos) << markdown;
 }
 
+TEST(ComparisonTest, FrameStatsReadBackWhatRefineWrites) {
+  FrameStats written = Record(-2.5, 7.0, 3.5, 1.25);
+  written.frame = "000004";
+  written.kept_input = true;
+  const std::string dir = MakeTempDir("stats");
+  WriteText(dir + "/000004.json", ToJson(written) + "\n");
+  const FrameStats read = ReadFrameStats(dir + "/000004.json");
+  EXPECT_EQ(read.frame, "000004");
+  EXPECT_EQ(read.solver, "ceres");
+  EXPECT_DOUBLE_EQ(read.energy_end, -2.5);
+  EXPECT_DOUBLE_EQ(read.seconds_solve, 0.625);
+  EXPECT_EQ(read.evaluations, 6);
+  EXPECT_TRUE(read.kept_input);
+  EXPECT_TRUE(std::isnan(read.rms_textureless_refined_mm));  // Written as null.
+  WriteText(dir + "/short.json", "{\"frame\": \"1\", \"solver\": \"ceres\"}\n");
+  ExpectErrorMentions([&] { ReadFrameStats(dir + "/short.json"); }, {"short.json", "similarity"});
+  ExpectErrorMentions([&] { ReadFrameStats(dir + "/none.json"); }, {"none.json", "cannot open"});
+}
+
 TEST(ComparisonTest, SummaryRefusesMismatchedInputs) {
   ExpectErrorMentions([] { SummarizeVariant("v", {}, {}); }, {"v", "no refined frame"});
   ExpectErrorMentions([] { SummarizeVariant("v", {Record(-1, 1, 1, 1)}, {}); },
