@@ -67,20 +67,22 @@ std::vector<double> Column(const std::vector<FrameStats>& frames, Number FrameSt
 double Median(const std::vector<double>& values) { return Percentile(values, 50.0); }
 
 // The numeric columns of every table after variant, solver, similarity and frames, in order:
-// CSV name, heading with unit, field and the factor it is shown with.
+// CSV name, heading with unit, field, the factor it is shown with, and the significant digits
+// of the readable tables (energies of variants that converged differ in the fourth digit).
 struct NumberColumn {
   const char* csv;
   const char* heading;
   double VariantSummary::*field;
   double scale;
+  int digits = 4;
 };
 
 const std::vector<NumberColumn>& NumberColumns() {
   using V = VariantSummary;
   static const std::vector<NumberColumn> kColumns = {
-      {"energy_end", "E reached (own energy)", &V::energy_end, 1.0},
-      {"paper_e_sim", "paper's E_sim at result", &V::paper_similarity, 1.0},
-      {"ls_cost_end", "LS cost", &V::ls_cost_end, 1.0},
+      {"energy_end", "E reached (own energy)", &V::energy_end, 1.0, 6},
+      {"paper_e_sim", "paper's E_sim at result", &V::paper_similarity, 1.0, 6},
+      {"ls_cost_end", "LS cost", &V::ls_cost_end, 1.0, 6},
       {"rms_input_mm", "RMS input mm", &V::rms_input_mm, 1.0},
       {"rms_textured_mm", "RMS textured mm", &V::rms_textured_mm, 1.0},
       {"rms_textureless_mm", "RMS textureless mm", &V::rms_textureless_mm, 1.0},
@@ -207,7 +209,9 @@ std::vector<std::vector<TableCell>> ComparisonTableRows(const std::vector<Varian
   std::vector<std::vector<TableCell>> cells;
   for (const VariantSummary& row : rows) {
     std::vector<TableCell> line = {row.name, row.solver, row.similarity, row.frames};
-    for (const NumberColumn& column : NumberColumns()) line.push_back(Value(column, row));
+    for (const NumberColumn& column : NumberColumns()) {
+      line.push_back(TableCell::Number(Value(column, row), column.digits));
+    }
     cells.push_back(line);
   }
   return cells;
