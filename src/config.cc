@@ -175,6 +175,7 @@ void Config::Check() const {
   frame_range();
   refine.Check();
   synth.Check();
+  compare.Check();
 }
 
 ConfigSchema MakeConfigSchema(Config* config) {
@@ -184,6 +185,7 @@ ConfigSchema MakeConfigSchema(Config* config) {
   AddEnergyKeys(&config->refine.energy, &schema);
   AddSolverKeys(&config->refine.solver, &config->refine, &schema);
   AddSynthKeys(&config->synth, &schema);
+  AddCompareKeys(&config->compare, &schema);
   return schema;
 }
 

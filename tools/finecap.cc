@@ -75,6 +75,12 @@ const std::vector<Subcommand>& Subcommands() {
        "finecap eval --config FILE [--capture DIR] [--out DIR] [--frames A:B]",
        &RunEval,
        {"config", "capture", "out", "frames", "set"}},
+      {"compare",
+       "Refine the same frames with several variants (section compare) and compare them: "
+       "comparison.csv, comparison.md, convergence plots and report.html in the output folder.",
+       "finecap compare --config configs/compare_solvers.yaml [--frames A:B] [--out DIR]",
+       &RunCompare,
+       {"config", "capture", "out", "frames", "threads", "set"}},
   };
   return kSubcommands;
 }

@@ -28,6 +28,13 @@ int RunEval(const Config& config);
 // displacement as vertex quality, in output.dir/export/.
 int RunExport(const Config& config);
 
+// Refines the configured frames once per variant of section compare, each into
+// output.dir/<variant>/ as RunRefine does, and compares them: output.dir/comparison.csv and
+// comparison.md (one row per variant), convergence_iterations.png and convergence_time.png (the
+// last frame's solver traces) and report.html. Every variant is checked before anything is
+// written; a rerun skips the frames already done.
+int RunCompare(const Config& config);
+
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "finecap/compare_config.h"
 #include "finecap/config_schema.h"
 #include "finecap/frame_range.h"
 #include "finecap/refine.h"
@@ -66,6 +67,8 @@ struct Config {
   RefineOptions refine;
   // `finecap synth` (section synth).
   SynthOptions synth;
+  // `finecap compare` (section compare).
+  CompareConfig compare;
 
   // Cross-key checks that a single key's range cannot express. Throws Error naming the keys.
   void Check() const;
@@ -78,6 +81,10 @@ ConfigSchema MakeConfigSchema(Config* config);
 // The keys of section `synth` (config_synth.cc), bound to `*options`.
 void AddSynthKeys(SynthOptions* options, ConfigSchema* schema);
 
+// The keys of section `compare` (config_compare.cc), bound to `*compare`. Each variant's
+// settings are checked against a schema of their own when read.
+void AddCompareKeys(CompareConfig* compare, ConfigSchema* schema);
+
 // A key=value override from the command line; `source` names it in errors (e.g. "--set").
 struct ConfigOverride {
   std::string key;
@@ -88,6 +95,10 @@ struct ConfigOverride {
 // Defaults, then `file` (unless empty), then the overrides in order; then Config::Check().
 // Throws Error naming the file (or override) and the key on any problem.
 Config LoadConfig(const std::string& file, const std::vector<ConfigOverride>& overrides);
+
+// `base` with the settings of `variant` applied in order, then Config::Check(). Throws Error
+// naming variant.source and the key on any problem.
+Config VariantConfig(const Config& base, const CompareVariant& variant);
 
 }  // namespace finecap
 

@@ -11,6 +11,7 @@
 #include "finecap/frame_stats.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
+#include "finecap/solver_trace.h"
 
 namespace finecap {
 namespace {
@@ -19,12 +20,12 @@ namespace fs = std::filesystem;
 
 // Where the results of one frame go.
 struct FramePaths {
-  std::string mesh, displacement, stats;
+  std::string mesh, displacement, stats, trace;
 };
 
 FramePaths OutputPaths(const std::string& out, const std::string& frame, const Config& config) {
   return {out + "/meshes/" + frame + "." + config.output.mesh_format, out + "/k/" + frame + ".txt",
-          out + "/frames/" + frame + ".json"};
+          out + "/frames/" + frame + ".json", out + "/traces/" + frame + ".csv"};
 }
 
 void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k) {
@@ -99,7 +100,8 @@ int RunRefine(const Config& config) {
   Capture capture = internal::OpenConfiguredCapture(config);
   const FrameRange frames = internal::ConfiguredFrames(config, capture);
   const std::string out = internal::PrepareOutputFolder(config, capture);
-  for (const char* folder : {"meshes", "k", "frames"}) fs::create_directories(out + "/" + folder);
+  for (const char* folder : {"meshes", "k", "frames", "traces"})
+    fs::create_directories(out + "/" + folder);
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
@@ -132,6 +134,7 @@ int RunRefine(const Config& config) {
     WriteMesh(paths.mesh, result.refined, {result.normals, {}, quality},
               config.output.mesh_format == "obj" ? MeshFormat::kObj : MeshFormat::kPly);
     WriteDisplacement(paths.displacement, result.k);
+    WriteTextFileAtomically(paths.trace, SolverTraceCsv(result.summary.trace));
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteTextFileAtomically(paths.stats, ToJson(stats) + "\n");
     WriteStatsLines(out, capture, config);
