@@ -1,8 +1,11 @@
 #include "finecap/frame_stats.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "finecap/error.h"
+#include "flat_json.h"
 #include "io_util.h"
 
 namespace finecap {
@@ -61,8 +64,119 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
-       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm) << "}";
+       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
+       << ", \"skipped_cameras\": [";
+  for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
+    json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
+  }
+  json << "]}";
   return json.str();
+}
+
+namespace {
+
+using internal::FlatJsonValue;
+
+// Which field of FrameStats each key of a record fills.
+struct StatsFields {
+  std::vector<std::pair<const char*, std::string FrameStats::*>> strings = {
+      {"frame", &FrameStats::frame},
+      {"solver", &FrameStats::solver},
+      {"similarity", &FrameStats::similarity},
+      {"termination", &FrameStats::termination}};
+  std::vector<std::pair<const char*, double FrameStats::*>> reals = {
+      {"energy_start", &FrameStats::energy_start},
+      {"energy_end", &FrameStats::energy_end},
+      {"ls_cost_start", &FrameStats::ls_cost_start},
+      {"ls_cost_end", &FrameStats::ls_cost_end},
+      {"seconds", &FrameStats::seconds},
+      {"seconds_preparation", &FrameStats::seconds_preparation},
+      {"seconds_solve", &FrameStats::seconds_solve},
+      {"seconds_evaluation", &FrameStats::seconds_evaluation},
+      {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
+      {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
+      {"rms_refined_mm", &FrameStats::rms_refined_mm},
+      {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
+      {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm}};
+  std::vector<std::pair<const char*, int FrameStats::*>> ints = {
+      {"iterations", &FrameStats::iterations},
+      {"evaluations", &FrameStats::evaluations},
+      {"surface_gaussians", &FrameStats::surface_gaussians}};
+  std::vector<std::pair<const char*, long FrameStats::*>> longs = {
+      {"image_gaussians", &FrameStats::image_gaussians}, {"pairs", &FrameStats::pairs}};
+  std::vector<std::pair<const char*, bool FrameStats::*>> bools = {
+      {"worse", &FrameStats::worse}, {"kept_input", &FrameStats::kept_input}};
+};
+
+void RequireKind(const FlatJsonValue& value, FlatJsonValue::Kind kind, const std::string& where,
+                 const std::string& key, const std::string& expected) {
+  Require(value.kind == kind, where, "key \"" + key + "\" must be " + expected);
+}
+
+// A whole number within [min, max], as a long.
+long ReadWholeNumber(const FlatJsonValue& value, const std::string& where, const std::string& key,
+                     long min, long max) {
+  RequireKind(value, FlatJsonValue::Kind::kNumber, where, key, "an integer");
+  Require(value.number == std::floor(value.number) && value.number >= static_cast<double>(min) &&
+              value.number <= static_cast<double>(max),
+          where,
+          "key \"" + key + "\" must be an integer in [" + std::to_string(min) + ", " +
+              std::to_string(max) + "]");
+  return static_cast<long>(value.number);
+}
+
+// Fills the field named `key`; false when no field has that name.
+bool AssignField(const std::string& key, const FlatJsonValue& value, const std::string& where,
+                 FrameStats* stats) {
+  static const StatsFields fields;
+  for (const auto& [name, field] : fields.strings) {
+    if (key != name) continue;
+    RequireKind(value, FlatJsonValue::Kind::kString, where, key, "a string");
+    stats->*field = value.text;
+    return true;
+  }
+  for (const auto& [name, field] : fields.reals) {
+    if (key != name) continue;
+    Require(value.kind == FlatJsonValue::Kind::kNumber || value.kind == FlatJsonValue::Kind::kNull,
+            where, "key \"" + key + "\" must be a number or null");
+    stats->*field = value.kind == FlatJsonValue::Kind::kNull ? std::nan("") : value.number;
+    return true;
+  }
+  for (const auto& [name, field] : fields.ints) {
+    if (key != name) continue;
+    stats->*field =
+        static_cast<int>(ReadWholeNumber(value, where, key, 0, std::numeric_limits<int>::max()));
+    return true;
+  }
+  // 2^53: the largest range in which every whole double is exact.
+  for (const auto& [name, field] : fields.longs) {
+    if (key != name) continue;
+    stats->*field = ReadWholeNumber(value, where, key, 0, 1L << 53);
+    return true;
+  }
+  for (const auto& [name, field] : fields.bools) {
+    if (key != name) continue;
+    RequireKind(value, FlatJsonValue::Kind::kBool, where, key, "true or false");
+    stats->*field = value.boolean;
+    return true;
+  }
+  if (key != "skipped_cameras") return false;
+  RequireKind(value, FlatJsonValue::Kind::kStringList, where, key, "a list of strings");
+  stats->skipped_cameras = value.texts;
+  return true;
+}
+
+}  // namespace
+
+FrameStats ParseFrameStats(const std::string& line, const std::string& where) {
+  FrameStats stats;
+  bool has_frame = false;
+  for (const auto& [key, value] : internal::ParseFlatJsonObject(line, where)) {
+    Require(AssignField(key, value, where, &stats), where, "unknown key \"" + key + "\"");
+    has_frame = has_frame || key == "frame";
+  }
+  Require(has_frame, where, "missing key \"frame\"");
+  return stats;
 }
 
 }  // namespace finecap
