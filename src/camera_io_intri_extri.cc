@@ -17,8 +17,14 @@ cv::FileStorage OpenStorage(const std::string& path) {
     cv::FileStorage storage(path, cv::FileStorage::READ);
     Require(storage.isOpened(), path, "cannot open as an OpenCV YAML/XML file");
     return storage;
+  } catch (const Error&) {
+    throw;
   } catch (const cv::Exception& error) {
     throw Error(path, "malformed OpenCV YAML/XML file: " + error.msg);
+  } catch (const std::exception& error) {
+    // OpenCV's parser lets library exceptions through on some damaged files (std::length_error
+    // from a string it sizes from the file).
+    throw Error(path, std::string("malformed OpenCV YAML/XML file: ") + error.what());
   }
 }
 

@@ -31,18 +31,6 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
 
 }  // namespace
 
-void RefineOptions::Check() const {
-  Require(subdivision_levels >= 0 && subdivision_levels <= 4, "model.subdivision_levels",
-          "must lie in [0, 4]");
-  Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
-  Require(reference_colors == "pixels" || reference_colors == "image_model",
-          "model.reference_colors", "must be pixels or image_model");
-  image.Check();
-  visibility.Check();
-  energy.Check();
-  solver.Check();
-  sweep.Check();
-}
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
