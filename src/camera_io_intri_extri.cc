@@ -32,11 +32,29 @@ std::string KeyLocation(const std::string& path, const std::string& key) {
   return path + " (key '" + key + "')";
 }
 
+// OpenCV allocates the size a matrix node declares before it reads the data, so a damaged `rows`
+// or `cols` could ask for gigabytes: the declared size is checked first. A rig's matrices are at
+// most 3x3 or 1x5.
+void RequireSmallMatrixNode(const cv::FileNode& node, const std::string& where) {
+  constexpr int kMaxSide = 16;
+  Require(node.isMap(), where, "is not an OpenCV matrix (a map of rows, cols, dt, data)");
+  const cv::FileNode rows = node["rows"];
+  const cv::FileNode cols = node["cols"];
+  Require(rows.isInt() && cols.isInt(), where, "the matrix's rows and cols must be integers");
+  const int num_rows = static_cast<int>(rows);
+  const int num_cols = static_cast<int>(cols);
+  Require(num_rows >= 0 && num_rows <= kMaxSide && num_cols >= 0 && num_cols <= kMaxSide, where,
+          "declares a " + std::to_string(num_rows) + "x" + std::to_string(num_cols) +
+              " matrix; a camera's matrices have at most " + std::to_string(kMaxSide) +
+              " rows and columns");
+}
+
 // The matrix stored under `key`, as doubles; empty when the key is absent.
 cv::Mat ReadMatrix(const cv::FileStorage& storage, const std::string& key,
                    const std::string& path) {
   const cv::FileNode node = storage[key];
   if (node.empty() || node.isNone()) return cv::Mat();
+  RequireSmallMatrixNode(node, KeyLocation(path, key));
   cv::Mat matrix;
   try {
     node >> matrix;

@@ -31,7 +31,6 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
 
 }  // namespace
 
-
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
     : stencil_(BuildLoopSubdivision(first_coarse, options.subdivision_levels, where)),
@@ -124,7 +123,8 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.summary = Solve(&energy, options.solver, &k);
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
-  result.kept_input = result.worse && options.keep_input_if_worse;
+  // With no surface Gaussian (no camera sees a refined vertex) the input is all there is.
+  result.kept_input = (result.worse && options.keep_input_if_worse) || k.size() == 0;
 
   const double bias = options.bias_compensation ? options.sigma_hat : 0.0;
   result.refined = frame.fine;

@@ -24,5 +24,21 @@ TEST(FuzzRegression, IntriYmlThatMadeOpenCvThrowALengthError) {
                       {dir + "/intri.yml", "malformed OpenCV YAML/XML file"});
 }
 
+// A damaged `cols` made OpenCV allocate 17 GB for K before reading its nine numbers.
+TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
+  const std::string dir = MakeTempDir("fuzz_intri_size");
+  WriteText(dir + "/intri.yml",
+            "%YAML:1.0\n---\nnames: [\"01\"]\nK_01: !!opencv-matrix\n   rows: 3\n   cols:\xa0"
+            "5\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {dir + "/intri.yml", "K_01"});
+  WriteText(dir + "/intri.yml",
+            "%YAML:1.0\n---\nnames: [\"01\"]\nK_01: !!opencv-matrix\n   rows: 3\n   cols: "
+            "300000\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {dir + "/intri.yml", "K_01", "3x300000", "at most 16"});
+}
+
 }  // namespace
 }  // namespace finecap
