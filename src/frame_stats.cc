@@ -144,14 +144,14 @@ bool AssignField(const std::string& key, const FlatJsonValue& value, const std::
   }
   for (const auto& [name, field] : fields.ints) {
     if (key != name) continue;
-    stats->*field =
-        static_cast<int>(ReadWholeNumber(value, where, key, 0, std::numeric_limits<int>::max()));
+    stats->*field = static_cast<int>(ReadWholeNumber(
+        value, where, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
     return true;
   }
   // 2^53: the largest range in which every whole double is exact.
   for (const auto& [name, field] : fields.longs) {
     if (key != name) continue;
-    stats->*field = ReadWholeNumber(value, where, key, 0, 1L << 53);
+    stats->*field = ReadWholeNumber(value, where, key, -(1L << 53), 1L << 53);
     return true;
   }
   for (const auto& [name, field] : fields.bools) {

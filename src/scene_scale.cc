@@ -33,9 +33,9 @@ void RequirePlausibleSceneScale(const Mesh& mesh, double sigma_hat, const std::s
                "a subject larger than "
             << limits.max_sigmas * sigma_hat << " m";
   } else {
-    problem << ", and a mesh this small looks like one in a larger unit than metres: convert the "
-               "capture to metres, or lower model.sigma_hat (and energy.k_max) for a subject "
-               "smaller than "
+    problem << ", and a mesh this small is too small for the surface Gaussians (or in a larger "
+               "unit than metres): convert the capture to metres, or lower model.sigma_hat (and "
+               "energy.k_max) for a subject smaller than "
             << limits.min_sigmas * sigma_hat << " m";
   }
   throw Error(where, problem.str());

@@ -110,7 +110,6 @@ TEST(FrameStatsParse, RefusesMalformedRecordsNamingTheProblem) {
   ExpectErrorMentions(parse(R"({"frame": 1})"), {where, "\"frame\" must be a string"});
   ExpectErrorMentions(parse(R"({"frame": "1", "iterations": 2.5})"),
                       {where, "\"iterations\" must be an integer"});
-  ExpectErrorMentions(parse(R"({"frame": "1", "iterations": -1})"), {where, "iterations"});
   ExpectErrorMentions(parse(R"({"frame": "1", "iterations": 1e300})"), {where, "iterations"});
   ExpectErrorMentions(parse(R"({"frame": "1", "worse": 1})"), {where, "true or false"});
   ExpectErrorMentions(parse(R"({"frame": "1", "seconds": "2"})"), {where, "number or null"});

@@ -9,9 +9,11 @@
 #include "finecap/camera_io.h"
 #include "finecap/capture.h"
 #include "finecap/commands.h"
+#include "finecap/frame_stats.h"
 #include "finecap/mesh_diagnostics.h"
 #include "finecap/mesh_io.h"
 #include "finecap/refine.h"
+#include "finecap/scene_scale.h"
 #include "finecap/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
@@ -123,13 +125,17 @@ TEST(HostileGeometry, VerticesSeenByNoCameraGetNoGaussian) {
   input.images.resize(1);
   const FrameResult result = Refine(input, FastOptions());
   ExpectFiniteResult(result);
-  const auto visible = ComputeFrameVisibility(result.refined, result.normals, input.cameras,
+  // Exactly the vertices that the camera sees on the input surface have a displacement.
+  const Mesh fine = SequenceModel(input.coarse, {}, FastOptions(), "test").Subdivide(input.coarse);
+  const auto visible = ComputeFrameVisibility(fine, ComputeVertexNormals(fine), input.cameras,
                                               FastOptions().visibility);
-  int unrefined = 0;
-  for (int v = 0; v < result.k.size(); ++v) unrefined += std::isnan(result.k[v]) ? 1 : 0;
-  EXPECT_EQ(result.num_surface_gaussians + unrefined, result.k.size());
-  EXPECT_GT(unrefined, result.k.size() / 3);  // At least the back, out of a camera's sight.
-  EXPECT_GT(result.num_surface_gaussians, 0);
+  int unseen = 0;
+  for (int v = 0; v < result.k.size(); ++v) {
+    EXPECT_EQ(std::isnan(result.k[v]), visible[0][v] == 0) << v;
+    unseen += visible[0][v] == 0 ? 1 : 0;
+  }
+  EXPECT_GT(unseen, result.k.size() / 3);  // At least the back of the skirt.
+  EXPECT_EQ(result.num_surface_gaussians, result.k.size() - unseen);
 }
 
 // Camera `camera` turned round about its own y axis: everything it saw is now behind it.
@@ -163,6 +169,74 @@ TEST(HostileGeometry, NoCameraSeesTheMesh) {
   const FrameResult result = Refine(blind, FastOptions());
   ExpectFiniteResult(result);
   EXPECT_EQ(result.num_surface_gaussians, 0);
+}
+
+TEST(HostileGeometry, RefineKeepsTheInputWhenEveryCameraHasTheMeshBehindIt) {
+  const std::string capture = MakeTinyCapture("behind_all_command");
+  std::vector<Camera> cameras = ReadCamerasYaml(capture + "/cameras.yaml");
+  for (Camera& camera : cameras) camera = TurnedAround(camera);
+  for (Camera& camera : cameras) camera.name.resize(camera.name.size() - 7);  // Keep the names.
+  std::filesystem::remove(capture + "/cameras.yaml");
+  WriteCamerasYaml(cameras, capture + "/cameras.yaml");
+  Config config;
+  config.capture.dir = capture;
+  config.output.dir = capture + "/../out";
+  config.refine.solver.num_threads = 1;
+  ASSERT_EQ(RunRefine(config), 0);
+  const std::string record = testing_util::FileBytes(capture + "/../out/frames/000000.json");
+  const FrameStats stats = ParseFrameStats(record, "000000.json");
+  EXPECT_TRUE(stats.kept_input);
+  EXPECT_EQ(stats.surface_gaussians, 0);
+  const Mesh written = ReadMesh(capture + "/../out/meshes/000000.ply");
+  const Mesh input = ReadMesh(capture + "/meshes/000000.ply");
+  const Mesh fine = SequenceModel(input, {}, config.refine, "test").Subdivide(input);
+  EXPECT_LT((written.vertices - fine.vertices).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// A square of side `side` in the z = 0 plane, two triangles.
+Mesh Square(double side) {
+  Mesh mesh;
+  mesh.vertices.resize(3, 4);
+  mesh.vertices << 0, side, side, 0, 0, 0, side, side, 0, 0, 0, 0;
+  mesh.faces.resize(3, 2);
+  mesh.faces << 0, 0, 1, 2, 2, 3;
+  return mesh;
+}
+
+TEST(SceneScale, MeasuresTheBoundingBoxAgainstSigmaHat) {
+  EXPECT_DOUBLE_EQ(BoundingBoxDiagonal(Square(3.0)), 3.0 * std::sqrt(2.0));
+  // 1 m: 202 sigma_hat of 7 mm, a subject in metres.
+  EXPECT_NO_THROW(RequirePlausibleSceneScale(Square(1.0), 0.007, "m.ply"));
+  // The same square in millimetres: 202,000 sigma_hat.
+  ExpectErrorMentions([] { RequirePlausibleSceneScale(Square(1000.0), 0.007, "mm.ply"); },
+                      {"mm.ply", "1414 across", "2.02e+05 times model.sigma_hat", "millimetres",
+                       "convert the capture"});
+  // 1 cm: 2 sigma_hat, the Gaussians would cover it whole.
+  ExpectErrorMentions([] { RequirePlausibleSceneScale(Square(0.01), 0.007, "tiny.ply"); },
+                      {"tiny.ply", "2.02 times", "too small", "0.035 m"});
+  // Scaling sigma_hat with the subject is accepted.
+  EXPECT_NO_THROW(RequirePlausibleSceneScale(Square(0.01), 0.00007, "tiny.ply"));
+  SceneScaleLimits bad;
+  bad.max_sigmas = bad.min_sigmas;
+  EXPECT_THROW(RequirePlausibleSceneScale(Square(1.0), 0.007, "m.ply", bad), Error);
+}
+
+TEST(SceneScale, RefineRefusesACaptureInMillimetresBeforeWritingAnything) {
+  const std::string capture = MakeTinyCapture("millimetres");
+  const std::string mesh_path = capture + "/meshes/000000.ply";
+  Mesh mesh = ReadMesh(mesh_path);
+  mesh.vertices *= 1000.0;
+  std::filesystem::remove(mesh_path);
+  WriteMesh(mesh_path, mesh);
+  std::vector<Camera> cameras = ReadCamerasYaml(capture + "/cameras.yaml");
+  for (Camera& camera : cameras) camera.t *= 1000.0;
+  std::filesystem::remove(capture + "/cameras.yaml");
+  WriteCamerasYaml(cameras, capture + "/cameras.yaml");
+  Config config;
+  config.capture.dir = capture;
+  config.output.dir = capture + "/../out";
+  ExpectErrorMentions([&] { RunRefine(config); }, {mesh_path, "millimetres"});
+  EXPECT_FALSE(std::filesystem::exists(capture + "/../out"));
 }
 
 }  // namespace
