@@ -40,8 +40,10 @@ for fuzzer in "$build_dir"/tests/fuzz/*_fuzzer; do
   mkdir -p "$corpus"
   seeds=(tests/fuzz/corpus/"$name")
   if [ -d "$generated/$name" ]; then seeds+=("$generated/$name"); fi
+  options=()
+  if [ -f "tests/fuzz/$name.dict" ]; then options+=(-dict="tests/fuzz/$name.dict"); fi
   echo "fuzz: $name for ${seconds} s"
-  if ! "$fuzzer" "$corpus" "${seeds[@]}" -max_total_time="$seconds" -rss_limit_mb=2048 \
+  if ! "$fuzzer" "$corpus" "${seeds[@]}" "${options[@]}" -max_total_time="$seconds" -rss_limit_mb=2048 \
     -timeout=10 -max_len=8192 -artifact_prefix="$build_dir/fuzz-artifacts/$name-" \
     -print_final_stats=1 >"$build_dir/fuzz-$name.log" 2>&1; then
     tail -n 40 "$build_dir/fuzz-$name.log"

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "finecap/camera_io.h"
+#include "finecap/config.h"
 #include "test_util.h"
 
 namespace finecap {
@@ -38,6 +39,24 @@ TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
             "300000\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
                       {dir + "/intri.yml", "K_01", "3x300000", "at most 16"});
+}
+
+// YAML allows a list or a mapping as a key; yaml-cpp's conversion of it to a string threw
+// YAML::TypedBadConversion past our parsers.
+TEST(FuzzRegression, YamlKeysThatAreListsOrMappings) {
+  const std::string dir = MakeTempDir("fuzz_yaml_keys");
+  WriteText(dir + "/top.yaml", "? [a, b]\n: 1\n");
+  ExpectErrorMentions([&] { LoadConfig(dir + "/top.yaml", {}); },
+                      {dir + "/top.yaml", "a key must be a name", "line 1"});
+  WriteText(dir + "/section.yaml", "model: {? [x] : 1}\n");
+  ExpectErrorMentions([&] { LoadConfig(dir + "/section.yaml", {}); },
+                      {dir + "/section.yaml", "model....", "a key must be a name"});
+  WriteText(dir + "/camera.yaml", "cameras:\n  - name: a\n    ? [x]\n    : 1\n");
+  ExpectErrorMentions([&] { ReadCamerasYaml(dir + "/camera.yaml"); },
+                      {dir + "/camera.yaml", "camera #0", "a key must be a name", "line 3"});
+  WriteText(dir + "/rig.yaml", "cameras: [1]\n? [x]\n: 1\n");
+  ExpectErrorMentions([&] { ReadCamerasYaml(dir + "/rig.yaml"); },
+                      {dir + "/rig.yaml", "a key must be a name", "line 2"});
 }
 
 }  // namespace
