@@ -16,6 +16,8 @@ cv::FileStorage OpenStorage(const std::string& path) {
   try {
     cv::FileStorage storage(path, cv::FileStorage::READ);
     Require(storage.isOpened(), path, "cannot open as an OpenCV YAML/XML file");
+    // Looking a key up in anything but a mapping is an assertion failure in OpenCV.
+    Require(storage.root().isMap(), path, "the top level must be a mapping of keys");
     return storage;
   } catch (const Error&) {
     throw;
@@ -134,13 +136,18 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
   const cv::FileStorage intri = OpenStorage(intri_path);
   const cv::FileStorage extri = OpenStorage(extri_path);
   std::vector<Camera> cameras;
-  for (const std::string& name : ReadNames(intri, intri_path)) {
-    Camera camera;
-    camera.name = name;
-    ReadIntrinsics(intri, intri_path, &camera);
-    ReadExtrinsics(extri, extri_path, &camera);
-    internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
-    cameras.push_back(camera);
+  try {
+    for (const std::string& name : ReadNames(intri, intri_path)) {
+      Camera camera;
+      camera.name = name;
+      ReadIntrinsics(intri, intri_path, &camera);
+      ReadExtrinsics(extri, extri_path, &camera);
+      internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
+      cameras.push_back(camera);
+    }
+  } catch (const cv::Exception& error) {
+    // An OpenCV assertion that the checks above did not foresee still ends in one Error.
+    throw Error(intri_path + " / " + extri_path, "malformed OpenCV YAML/XML file: " + error.msg);
   }
   internal::RequireUniqueCameraNames(cameras, intri_path);
   return cameras;

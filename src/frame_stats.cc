@@ -106,6 +106,8 @@ struct StatsFields {
       {"image_gaussians", &FrameStats::image_gaussians}, {"pairs", &FrameStats::pairs}};
   std::vector<std::pair<const char*, bool FrameStats::*>> bools = {
       {"worse", &FrameStats::worse}, {"kept_input", &FrameStats::kept_input}};
+  std::vector<std::pair<const char*, std::vector<std::string> FrameStats::*>> lists = {
+      {"skipped_cameras", &FrameStats::skipped_cameras}};
 };
 
 void RequireKind(const FlatJsonValue& value, FlatJsonValue::Kind kind, const std::string& where,
@@ -125,45 +127,52 @@ long ReadWholeNumber(const FlatJsonValue& value, const std::string& where, const
   return static_cast<long>(value.number);
 }
 
+// Sets the field of `fields` named `key` to convert(); false when none has that name.
+template <typename Field, typename Convert>
+bool AssignNamed(const std::vector<std::pair<const char*, Field FrameStats::*>>& fields,
+                 const std::string& key, FrameStats* stats, Convert convert) {
+  for (const auto& [name, field] : fields) {
+    if (key != name) continue;
+    stats->*field = convert();
+    return true;
+  }
+  return false;
+}
+
 // Fills the field named `key`; false when no field has that name.
 bool AssignField(const std::string& key, const FlatJsonValue& value, const std::string& where,
                  FrameStats* stats) {
+  using Kind = FlatJsonValue::Kind;
   static const StatsFields fields;
-  for (const auto& [name, field] : fields.strings) {
-    if (key != name) continue;
-    RequireKind(value, FlatJsonValue::Kind::kString, where, key, "a string");
-    stats->*field = value.text;
-    return true;
-  }
-  for (const auto& [name, field] : fields.reals) {
-    if (key != name) continue;
-    Require(value.kind == FlatJsonValue::Kind::kNumber || value.kind == FlatJsonValue::Kind::kNull,
-            where, "key \"" + key + "\" must be a number or null");
-    stats->*field = value.kind == FlatJsonValue::Kind::kNull ? std::nan("") : value.number;
-    return true;
-  }
-  for (const auto& [name, field] : fields.ints) {
-    if (key != name) continue;
-    stats->*field = static_cast<int>(ReadWholeNumber(
-        value, where, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
-    return true;
-  }
+  const auto text = [&] {
+    RequireKind(value, Kind::kString, where, key, "a string");
+    return value.text;
+  };
+  const auto real = [&] {
+    Require(value.kind == Kind::kNumber || value.kind == Kind::kNull, where,
+            "key \"" + key + "\" must be a number or null");
+    return value.kind == Kind::kNull ? std::nan("") : value.number;
+  };
+  const auto whole_int = [&] {
+    return static_cast<int>(ReadWholeNumber(value, where, key, std::numeric_limits<int>::min(),
+                                            std::numeric_limits<int>::max()));
+  };
   // 2^53: the largest range in which every whole double is exact.
-  for (const auto& [name, field] : fields.longs) {
-    if (key != name) continue;
-    stats->*field = ReadWholeNumber(value, where, key, -(1L << 53), 1L << 53);
-    return true;
-  }
-  for (const auto& [name, field] : fields.bools) {
-    if (key != name) continue;
-    RequireKind(value, FlatJsonValue::Kind::kBool, where, key, "true or false");
-    stats->*field = value.boolean;
-    return true;
-  }
-  if (key != "skipped_cameras") return false;
-  RequireKind(value, FlatJsonValue::Kind::kStringList, where, key, "a list of strings");
-  stats->skipped_cameras = value.texts;
-  return true;
+  const auto whole_long = [&] { return ReadWholeNumber(value, where, key, -(1L << 53), 1L << 53); };
+  const auto boolean = [&] {
+    RequireKind(value, Kind::kBool, where, key, "true or false");
+    return value.boolean;
+  };
+  const auto texts = [&] {
+    RequireKind(value, Kind::kStringList, where, key, "a list of strings");
+    return value.texts;
+  };
+  return AssignNamed(fields.strings, key, stats, text) ||
+         AssignNamed(fields.reals, key, stats, real) ||
+         AssignNamed(fields.ints, key, stats, whole_int) ||
+         AssignNamed(fields.longs, key, stats, whole_long) ||
+         AssignNamed(fields.bools, key, stats, boolean) ||
+         AssignNamed(fields.lists, key, stats, texts);
 }
 
 }  // namespace

@@ -42,11 +42,11 @@ FrameStats SampleStats() {
   return stats;
 }
 
-void ExpectSameReal(double expected, double actual, const char* name) {
+void ExpectSameReal(double expected, double actual) {
   if (std::isnan(expected)) {
-    EXPECT_TRUE(std::isnan(actual)) << name;
+    EXPECT_TRUE(std::isnan(actual));
   } else {
-    EXPECT_EQ(expected, actual) << name;
+    EXPECT_EQ(expected, actual);
   }
 }
 
@@ -57,19 +57,14 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
   EXPECT_EQ(back.solver, stats.solver);
   EXPECT_EQ(back.similarity, stats.similarity);
   EXPECT_EQ(back.termination, stats.termination);
-  ExpectSameReal(stats.energy_start, back.energy_start, "energy_start");
-  ExpectSameReal(stats.energy_end, back.energy_end, "energy_end");
-  ExpectSameReal(stats.ls_cost_start, back.ls_cost_start, "ls_cost_start");
-  ExpectSameReal(stats.ls_cost_end, back.ls_cost_end, "ls_cost_end");
-  ExpectSameReal(stats.seconds, back.seconds, "seconds");
-  ExpectSameReal(stats.seconds_preparation, back.seconds_preparation, "seconds_preparation");
-  ExpectSameReal(stats.seconds_solve, back.seconds_solve, "seconds_solve");
-  ExpectSameReal(stats.seconds_evaluation, back.seconds_evaluation, "seconds_evaluation");
-  ExpectSameReal(stats.seconds_linear_solver, back.seconds_linear_solver, "linear_solver");
-  ExpectSameReal(stats.rms_coarse_mm, back.rms_coarse_mm, "rms_coarse_mm");
-  ExpectSameReal(stats.rms_refined_mm, back.rms_refined_mm, "rms_refined_mm");
-  ExpectSameReal(stats.rms_textureless_coarse_mm, back.rms_textureless_coarse_mm, "tl coarse");
-  ExpectSameReal(stats.rms_textureless_refined_mm, back.rms_textureless_refined_mm, "tl refined");
+  for (double FrameStats::*field :
+       {&FrameStats::energy_start, &FrameStats::energy_end, &FrameStats::ls_cost_start,
+        &FrameStats::ls_cost_end, &FrameStats::seconds, &FrameStats::seconds_preparation,
+        &FrameStats::seconds_solve, &FrameStats::seconds_evaluation,
+        &FrameStats::seconds_linear_solver, &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
+        &FrameStats::rms_textureless_coarse_mm, &FrameStats::rms_textureless_refined_mm}) {
+    ExpectSameReal(stats.*field, back.*field);
+  }
   EXPECT_EQ(back.iterations, 17);
   EXPECT_EQ(back.evaluations, 23);
   EXPECT_EQ(back.surface_gaussians, 10112);

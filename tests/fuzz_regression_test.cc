@@ -25,6 +25,15 @@ TEST(FuzzRegression, IntriYmlThatMadeOpenCvThrowALengthError) {
                       {dir + "/intri.yml", "malformed OpenCV YAML/XML file"});
 }
 
+// A top level that is a list: OpenCV asserted (cv::Exception) when a key was looked up in it.
+TEST(FuzzRegression, IntriYmlWhoseTopLevelIsAList) {
+  const std::string dir = MakeTempDir("fuzz_intri_list");
+  WriteText(dir + "/intri.yml", "%YAML:1.0\n- 0.\n- 1.\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {dir + "/intri.yml", "top level must be a mapping"});
+}
+
 // A damaged `cols` made OpenCV allocate 17 GB for K before reading its nine numbers.
 TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
   const std::string dir = MakeTempDir("fuzz_intri_size");

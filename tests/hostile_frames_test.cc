@@ -34,13 +34,7 @@ std::string MakeCapture(const std::string& root, int frames) {
 }
 
 Config FastConfig(const std::string& capture, const std::string& out) {
-  Config config;
-  config.capture.dir = capture;
-  config.output.dir = out;
-  config.runtime.threads = 1;
-  config.refine.solver.max_iterations = 2;
-  config.refine.solver.num_threads = 1;
-  return config;
+  return testing_util::TinyRunConfig(capture, out, 2);
 }
 
 // Replaces images/<camera>/ by videos/<camera>.avi holding its first `frames` images.

@@ -101,10 +101,7 @@ TEST(HostileGeometry, NonManifoldEdgeIsRefusedBySubdivisionNamingTheFile) {
   WriteMesh(mesh_path + ".tmp.ply", WithNonManifoldEdge(ReadMesh(mesh_path)));
   std::filesystem::rename(mesh_path + ".tmp.ply", mesh_path);
   ASSERT_EQ(DiagnoseMesh(ReadMesh(mesh_path)).num_non_manifold_edges, 1);
-  Config config;
-  config.capture.dir = capture;
-  config.output.dir = capture + "/../out";
-  config.refine.solver.max_iterations = 2;
+  const Config config = testing_util::TinyRunConfig(capture, capture + "/../out", 2);
   ExpectErrorMentions([&] { RunRefine(config); },
                       {"meshes/000000.ply", "non-manifold", "37", "38", "3 triangles"});
 }
@@ -178,10 +175,7 @@ TEST(HostileGeometry, RefineKeepsTheInputWhenEveryCameraHasTheMeshBehindIt) {
   for (Camera& camera : cameras) camera.name.resize(camera.name.size() - 7);  // Keep the names.
   std::filesystem::remove(capture + "/cameras.yaml");
   WriteCamerasYaml(cameras, capture + "/cameras.yaml");
-  Config config;
-  config.capture.dir = capture;
-  config.output.dir = capture + "/../out";
-  config.refine.solver.num_threads = 1;
+  const Config config = testing_util::TinyRunConfig(capture, capture + "/../out", 3);
   ASSERT_EQ(RunRefine(config), 0);
   const std::string record = testing_util::FileBytes(capture + "/../out/frames/000000.json");
   const FrameStats stats = ParseFrameStats(record, "000000.json");
@@ -232,9 +226,7 @@ TEST(SceneScale, RefineRefusesACaptureInMillimetresBeforeWritingAnything) {
   for (Camera& camera : cameras) camera.t *= 1000.0;
   std::filesystem::remove(capture + "/cameras.yaml");
   WriteCamerasYaml(cameras, capture + "/cameras.yaml");
-  Config config;
-  config.capture.dir = capture;
-  config.output.dir = capture + "/../out";
+  const Config config = testing_util::TinyRunConfig(capture, capture + "/../out", 2);
   ExpectErrorMentions([&] { RunRefine(config); }, {mesh_path, "millimetres"});
   EXPECT_FALSE(std::filesystem::exists(capture + "/../out"));
 }

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "finecap/error.h"
 
@@ -40,6 +41,21 @@ inline std::string WriteScratchFile(const std::string& name, const uint8_t* data
   stream.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   if (!stream) std::abort();  // The fuzzer's own failure, not the parser's.
   return path;
+}
+
+// The two files of a format that comes as a pair (COLMAP's cameras.txt + images.txt, intri.yml +
+// extri.yml): the input up to the first line "%%", and the rest (empty without such a line).
+inline std::pair<std::string, std::string> SplitInTwo(const uint8_t* data, size_t size) {
+  const std::string input(reinterpret_cast<const char*>(data), size);
+  const std::string separator = "\n%%\n";
+  const size_t split = input.find(separator);
+  if (split == std::string::npos) return {input, ""};
+  return {input.substr(0, split), input.substr(split + separator.size())};
+}
+
+// Writes `text` to `name` in the scratch folder; returns the file's path.
+inline std::string WriteScratchText(const std::string& name, const std::string& text) {
+  return WriteScratchFile(name, reinterpret_cast<const uint8_t*>(text.data()), text.size());
 }
 
 // Runs `parse`; an Error is the expected outcome of bad input, anything else a bug.
