@@ -20,7 +20,7 @@ using testing_util::WriteText;
 TEST(FuzzRegression, IntriYmlThatMadeOpenCvThrowALengthError) {
   const std::string dir = MakeTempDir("fuzz_intri");
   WriteText(dir + "/intri.yml", std::string("%YAML:1.\n   t:d\n   :\x01", 21));
-  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
                       {dir + "/intri.yml", "malformed OpenCV YAML/XML file"});
 }
@@ -29,7 +29,7 @@ TEST(FuzzRegression, IntriYmlThatMadeOpenCvThrowALengthError) {
 TEST(FuzzRegression, IntriYmlWhoseTopLevelIsAList) {
   const std::string dir = MakeTempDir("fuzz_intri_list");
   WriteText(dir + "/intri.yml", "%YAML:1.0\n- 0.\n- 1.\n");
-  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
                       {dir + "/intri.yml", "top level must be a mapping"});
 }
@@ -40,7 +40,7 @@ TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
   WriteText(dir + "/intri.yml",
             "%YAML:1.0\n---\nnames: [\"01\"]\nK_01: !!opencv-matrix\n   rows: 3\n   cols:\xa0"
             "5\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
-  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
                       {dir + "/intri.yml", "K_01"});
   WriteText(dir + "/intri.yml",
