@@ -21,6 +21,7 @@ void RefineOptions::Check() const {
   energy.Check();
   solver.Check();
   sweep.Check();
+  coarse_to_fine.Check();
 }
 
 void EnergyOptions::Check() const {
@@ -32,6 +33,9 @@ void EnergyOptions::Check() const {
   Require(k_max > 0.0, "energy.k_max", "must be positive");
   Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
   Require(w_prior >= 0.0, "energy.w_prior", "must be non-negative");
+  Require(confidence_prior >= 0.0, "energy.confidence_prior", "must be non-negative");
+  Require(confidence_threshold > 0.0, "energy.confidence_threshold", "must be positive");
+  Require(confidence_opening >= 0, "energy.confidence_opening", "must be non-negative");
   Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
   Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
 }
@@ -57,6 +61,11 @@ void SolverOptions::Check() const {
 void SweepOptions::Check() const {
   Require(samples == 0 || samples >= 3, "solver.sweep_samples", "must be 0 (off) or at least 3");
   Require(smoothing_rounds >= 0, "solver.sweep_smoothing_rounds", "must be non-negative");
+}
+
+void CoarseToFineOptions::Check() const {
+  Require(levels >= 1 && levels <= 5, "refine.coarse_to_fine.levels", "must lie in [1, 5]");
+  Require(scale > 1.0 && scale <= 4.0, "refine.coarse_to_fine.scale", "must lie in (1, 4]");
 }
 
 }  // namespace finecap

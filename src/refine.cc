@@ -1,6 +1,8 @@
 #include "finecap/refine.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "finecap/error.h"
 #include "finecap/frame_energy.h"
@@ -106,21 +108,81 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
   return frame;
 }
 
+namespace {
+
+// Level `level` of the coarse-to-fine schedule (0: the configured options): wider surface
+// Gaussians and larger image Gaussians, so that the energy is smoother in k and a fold further
+// than a Gaussian's width from the input surface is still within reach.
+RefineOptions LevelOptions(const RefineOptions& options, int level) {
+  RefineOptions level_options = options;
+  const double factor = std::pow(options.coarse_to_fine.scale, level);
+  level_options.sigma_hat *= factor;
+  level_options.image.min_leaf_size =
+      std::max(1, static_cast<int>(std::lround(options.image.min_leaf_size * factor)));
+  return level_options;
+}
+
+// The coarse levels of the schedule, coarsest first, each starting where the last one ended.
+// Returns the k to start the configured level from; adds the work done to *totals.
+Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const Eigen::VectorXd* warm_start, SolverSummary* totals,
+                                  double* seconds_preparation) {
+  Eigen::VectorXd k;
+  for (int level = options.coarse_to_fine.levels - 1; level >= 1; --level) {
+    const RefineOptions level_options = LevelOptions(options, level);
+    ReferenceColors level_colors = colors;
+    level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
+    PreparedFrame frame = PrepareFrame(model, level_colors, input, level_options);
+    *seconds_preparation += frame.seconds;
+    if (k.size() == 0) k = StartingPoint(frame.energy.get(), options.sweep, warm_start);
+    const SolverSummary summary = Solve(frame.energy.get(), options.solver, &k);
+    totals->iterations += summary.iterations;
+    totals->evaluations += summary.evaluations;
+    totals->seconds += summary.seconds;
+    totals->seconds_evaluation += summary.seconds_evaluation;
+    totals->seconds_linear_solver += summary.seconds_linear_solver;
+  }
+  return k;
+}
+
+}  // namespace
+
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start) {
+  if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
+  return SweepInitialization(energy, sweep);
+}
+
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
                         const Eigen::VectorXd* warm_start) {
   const auto start = std::chrono::steady_clock::now();
+  FrameResult result;
+  SolverSummary coarse;
+  const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, warm_start,
+                                                     &coarse, &result.seconds_preparation);
+
   PreparedFrame frame = PrepareFrame(model, colors, input, options);
   FrameEnergy& energy = *frame.energy;
-  FrameResult result;
   result.num_surface_gaussians = energy.num_parameters();
   result.num_image_gaussians = frame.num_image_gaussians;
   result.num_pairs = energy.num_pairs();
-  result.seconds_preparation = frame.seconds;
+  result.seconds_preparation += frame.seconds;
 
-  Eigen::VectorXd k = SweepInitialization(&energy, options.sweep);
-  if (warm_start != nullptr && warm_start->size() == k.size()) k = *warm_start;
+  // The frame got worse or better against where it started, before any level moved it.
+  const Eigen::VectorXd initial = StartingPoint(&energy, options.sweep, warm_start);
+  Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = Solve(&energy, options.solver, &k);
+  if (coarse_k.size() > 0) {
+    result.summary.energy_start = energy.Evaluate(initial, nullptr);
+    result.summary.ls_cost_start = LeastSquaresCost(&energy, initial);
+    result.summary.iterations += coarse.iterations;
+    result.summary.evaluations += coarse.evaluations;
+    result.summary.seconds += coarse.seconds;
+    result.summary.seconds_evaluation += coarse.seconds_evaluation;
+    result.summary.seconds_linear_solver += coarse.seconds_linear_solver;
+  }
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
   // With no surface Gaussian (no camera sees a refined vertex) the input is all there is.
