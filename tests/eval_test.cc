@@ -128,7 +128,13 @@ SynthOptions TinyCapture() {
 }
 
 Config RunConfig(const std::string& capture, const std::string& out) {
-  return testing_util::TinyRunConfig(capture, out, 5);
+  Config config;
+  config.capture.dir = capture;
+  config.output.dir = out;
+  config.runtime.threads = 1;
+  config.refine.solver.max_iterations = 5;
+  config.refine.solver.num_threads = 1;
+  return config;
 }
 
 // True when `path` is a PNG of `width` x `height` pixels.
