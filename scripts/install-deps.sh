@@ -10,6 +10,7 @@ PACKAGES=(
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox clang-format
+  clang-14 libclang-rt-14-dev
 )
 
 missing=()

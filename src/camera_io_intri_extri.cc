@@ -16,9 +16,17 @@ cv::FileStorage OpenStorage(const std::string& path) {
   try {
     cv::FileStorage storage(path, cv::FileStorage::READ);
     Require(storage.isOpened(), path, "cannot open as an OpenCV YAML/XML file");
+    // Looking a key up in anything but a mapping is an assertion failure in OpenCV.
+    Require(storage.root().isMap(), path, "the top level must be a mapping of keys");
     return storage;
+  } catch (const Error&) {
+    throw;
   } catch (const cv::Exception& error) {
     throw Error(path, "malformed OpenCV YAML/XML file: " + error.msg);
+  } catch (const std::exception& error) {
+    // OpenCV's parser lets library exceptions through on some damaged files (std::length_error
+    // from a string it sizes from the file).
+    throw Error(path, std::string("malformed OpenCV YAML/XML file: ") + error.what());
   }
 }
 
@@ -26,11 +34,29 @@ std::string KeyLocation(const std::string& path, const std::string& key) {
   return path + " (key '" + key + "')";
 }
 
+// OpenCV allocates the size a matrix node declares before it reads the data, so a damaged `rows`
+// or `cols` could ask for gigabytes: the declared size is checked first. A rig's matrices are at
+// most 3x3 or 1x5.
+void RequireSmallMatrixNode(const cv::FileNode& node, const std::string& where) {
+  constexpr int kMaxSide = 16;
+  Require(node.isMap(), where, "is not an OpenCV matrix (a map of rows, cols, dt, data)");
+  const cv::FileNode rows = node["rows"];
+  const cv::FileNode cols = node["cols"];
+  Require(rows.isInt() && cols.isInt(), where, "the matrix's rows and cols must be integers");
+  const int num_rows = static_cast<int>(rows);
+  const int num_cols = static_cast<int>(cols);
+  Require(num_rows >= 0 && num_rows <= kMaxSide && num_cols >= 0 && num_cols <= kMaxSide, where,
+          "declares a " + std::to_string(num_rows) + "x" + std::to_string(num_cols) +
+              " matrix; a camera's matrices have at most " + std::to_string(kMaxSide) +
+              " rows and columns");
+}
+
 // The matrix stored under `key`, as doubles; empty when the key is absent.
 cv::Mat ReadMatrix(const cv::FileStorage& storage, const std::string& key,
                    const std::string& path) {
   const cv::FileNode node = storage[key];
   if (node.empty() || node.isNone()) return cv::Mat();
+  RequireSmallMatrixNode(node, KeyLocation(path, key));
   cv::Mat matrix;
   try {
     node >> matrix;
@@ -110,13 +136,18 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
   const cv::FileStorage intri = OpenStorage(intri_path);
   const cv::FileStorage extri = OpenStorage(extri_path);
   std::vector<Camera> cameras;
-  for (const std::string& name : ReadNames(intri, intri_path)) {
-    Camera camera;
-    camera.name = name;
-    ReadIntrinsics(intri, intri_path, &camera);
-    ReadExtrinsics(extri, extri_path, &camera);
-    internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
-    cameras.push_back(camera);
+  try {
+    for (const std::string& name : ReadNames(intri, intri_path)) {
+      Camera camera;
+      camera.name = name;
+      ReadIntrinsics(intri, intri_path, &camera);
+      ReadExtrinsics(extri, extri_path, &camera);
+      internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
+      cameras.push_back(camera);
+    }
+  } catch (const cv::Exception& error) {
+    // An OpenCV assertion that the checks above did not foresee still ends in one Error.
+    throw Error(intri_path + " / " + extri_path, "malformed OpenCV YAML/XML file: " + error.msg);
   }
   internal::RequireUniqueCameraNames(cameras, intri_path);
   return cameras;

@@ -31,6 +31,14 @@ constexpr char kSchemaComment[] =
 
 const std::set<std::string> kCameraKeys = {"name", "width", "height", "K", "R", "t", "distortion"};
 
+// The text of a mapping's key; a list or mapping used as a key (YAML allows it) is refused.
+std::string KeyText(const YAML::Node& key, const std::string& where) {
+  Require(key.IsScalar(), where,
+          "a key must be a name, not a list or mapping (line " +
+              std::to_string(key.Mark().line + 1) + ")");
+  return key.Scalar();
+}
+
 // Where a value sits, for error messages: "cameras.yaml (camera 'cam0', key 'K')".
 std::string Location(const std::string& path, const std::string& camera, const std::string& key) {
   std::string location = path + " (camera '" + camera + "'";
@@ -73,7 +81,7 @@ Camera ReadCamera(const YAML::Node& node, int index, const std::string& path) {
   camera.name = ReadScalar<std::string>(node["name"], entry + " key 'name'", "a string");
   Require(!camera.name.empty(), entry, "empty camera name");
   for (const auto& item : node) {
-    const std::string key = item.first.as<std::string>();
+    const std::string key = KeyText(item.first, entry);
     Require(kCameraKeys.count(key) > 0, Location(path, camera.name, key), "unknown key");
   }
   for (const char* key : {"width", "height", "K", "R", "t"}) {
@@ -113,13 +121,10 @@ void EmitRowMajor(YAML::Emitter* out, const Eigen::Matrix3d& matrix) {
   *out << YAML::EndSeq;
 }
 
-}  // namespace
-
-std::vector<Camera> ReadCamerasYaml(const std::string& path) {
-  const YAML::Node root = LoadYaml(path);
+std::vector<Camera> CamerasFromYaml(const YAML::Node& root, const std::string& path) {
   Require(root.IsMap() && root["cameras"], path, "missing key 'cameras' at the top level");
   for (const auto& item : root) {
-    const std::string key = item.first.as<std::string>();
+    const std::string key = KeyText(item.first, path);
     Require(key == "cameras", path, "unknown top-level key '" + key + "'");
   }
   const YAML::Node list = root["cameras"];
@@ -130,6 +135,18 @@ std::vector<Camera> ReadCamerasYaml(const std::string& path) {
   }
   internal::RequireUniqueCameraNames(cameras, path);
   return cameras;
+}
+
+}  // namespace
+
+std::vector<Camera> ReadCamerasYaml(const std::string& path) {
+  const YAML::Node root = LoadYaml(path);
+  try {
+    return CamerasFromYaml(root, path);
+  } catch (const YAML::Exception& error) {
+    // A conversion that the checks above did not foresee still ends in one Error naming the file.
+    throw Error(path, std::string("cannot read the cameras: ") + error.what());
+  }
 }
 
 void WriteCamerasYaml(const std::vector<Camera>& cameras, const std::string& path) {

@@ -158,6 +158,11 @@ const std::string& Capture::frame_name(int frame) const {
   return frame_names_[frame];
 }
 
+const std::string& Capture::mesh_path(int frame) const {
+  RequireFrame(frame);
+  return mesh_paths_[frame];
+}
+
 Mesh Capture::ReadCoarseMesh(int frame) const {
   RequireFrame(frame);
   if (frame == 0) return first_mesh_;

@@ -13,6 +13,9 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.frames", &config->capture.frames,
                     "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
                     "\"\" = all.");
+  schema->AddBool("capture.skip_unreadable_cameras", &config->capture.skip_unreadable_cameras,
+                  "Refine a frame without a camera whose image cannot be read (warning; listed in "
+                  "the stats record's skipped_cameras) instead of stopping.");
   schema->AddString("output.dir", &config->output.dir,
                     "Output folder; created if missing; existing files are never overwritten.");
   schema->AddChoice("output.mesh_format", &config->output.mesh_format,

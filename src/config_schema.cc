@@ -178,7 +178,13 @@ void ConfigSchema::ReadFile(const std::string& file) {
     throw Error(file,
                 "malformed YAML at line " + std::to_string(error.mark.line + 1) + ": " + error.msg);
   }
-  ReadNode(root, file);
+  try {
+    ReadNode(root, file);
+  } catch (const YAML::Exception& error) {
+    // A conversion that the checks of each key did not foresee still ends in one Error naming
+    // the file.
+    throw Error(file, std::string("cannot read the config: ") + error.what());
+  }
 }
 
 void ConfigSchema::ReadNode(const YAML::Node& root, const std::string& file) {
@@ -190,7 +196,10 @@ void ConfigSchema::ReadNode(const YAML::Node& root, const std::string& file) {
 void ConfigSchema::ReadMapping(const YAML::Node& mapping, const std::string& prefix,
                                const std::string& file) {
   for (const auto& entry : mapping) {
-    const std::string path = prefix + entry.first.as<std::string>();
+    Require(entry.first.IsScalar(), KeyWhere(file, prefix + "..."),
+            "a key must be a name, not a list or mapping (line " +
+                std::to_string(entry.first.Mark().line + 1) + ")");
+    const std::string path = prefix + entry.first.Scalar();
     if (const Key* key = Find(path)) {
       key->assign(entry.second, KeyWhere(file, path));
       continue;

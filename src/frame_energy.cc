@@ -7,21 +7,6 @@
 
 namespace finecap {
 
-void EnergyOptions::Check() const {
-  Require(similarity == "paper" || similarity == "surface_color", "energy.similarity",
-          "'" + similarity + "' is not one of: paper, surface_color");
-  ParseOverlapForm(overlap);
-  Require(color_cutoff > 0.0, "energy.color_cutoff", "must be positive");
-  Require(reach_sigmas > 0.0, "energy.reach_sigmas", "must be positive");
-  Require(k_max > 0.0, "energy.k_max", "must be positive");
-  Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
-  Require(w_prior >= 0.0, "energy.w_prior", "must be non-negative");
-  Require(confidence_prior >= 0.0, "energy.confidence_prior", "must be non-negative");
-  Require(confidence_threshold > 0.0, "energy.confidence_threshold", "must be positive");
-  Require(confidence_opening >= 0, "energy.confidence_opening", "must be non-negative");
-  Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
-  Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
-}
 
 namespace {
 

@@ -1,8 +1,11 @@
 #include "finecap/frame_stats.h"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "finecap/error.h"
+#include "flat_json.h"
 #include "io_util.h"
 
 namespace finecap {
@@ -61,8 +64,128 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
-       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm) << "}";
+       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
+       << ", \"skipped_cameras\": [";
+  for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
+    json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
+  }
+  json << "]}";
   return json.str();
+}
+
+namespace {
+
+using internal::FlatJsonValue;
+
+// Which field of FrameStats each key of a record fills.
+struct StatsFields {
+  std::vector<std::pair<const char*, std::string FrameStats::*>> strings = {
+      {"frame", &FrameStats::frame},
+      {"solver", &FrameStats::solver},
+      {"similarity", &FrameStats::similarity},
+      {"termination", &FrameStats::termination}};
+  std::vector<std::pair<const char*, double FrameStats::*>> reals = {
+      {"energy_start", &FrameStats::energy_start},
+      {"energy_end", &FrameStats::energy_end},
+      {"ls_cost_start", &FrameStats::ls_cost_start},
+      {"ls_cost_end", &FrameStats::ls_cost_end},
+      {"seconds", &FrameStats::seconds},
+      {"seconds_preparation", &FrameStats::seconds_preparation},
+      {"seconds_solve", &FrameStats::seconds_solve},
+      {"seconds_evaluation", &FrameStats::seconds_evaluation},
+      {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
+      {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
+      {"rms_refined_mm", &FrameStats::rms_refined_mm},
+      {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
+      {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm}};
+  std::vector<std::pair<const char*, int FrameStats::*>> ints = {
+      {"iterations", &FrameStats::iterations},
+      {"evaluations", &FrameStats::evaluations},
+      {"surface_gaussians", &FrameStats::surface_gaussians}};
+  std::vector<std::pair<const char*, long FrameStats::*>> longs = {
+      {"image_gaussians", &FrameStats::image_gaussians}, {"pairs", &FrameStats::pairs}};
+  std::vector<std::pair<const char*, bool FrameStats::*>> bools = {
+      {"worse", &FrameStats::worse}, {"kept_input", &FrameStats::kept_input}};
+  std::vector<std::pair<const char*, std::vector<std::string> FrameStats::*>> lists = {
+      {"skipped_cameras", &FrameStats::skipped_cameras}};
+};
+
+void RequireKind(const FlatJsonValue& value, FlatJsonValue::Kind kind, const std::string& where,
+                 const std::string& key, const std::string& expected) {
+  Require(value.kind == kind, where, "key \"" + key + "\" must be " + expected);
+}
+
+// A whole number within [min, max], as a long.
+long ReadWholeNumber(const FlatJsonValue& value, const std::string& where, const std::string& key,
+                     long min, long max) {
+  RequireKind(value, FlatJsonValue::Kind::kNumber, where, key, "an integer");
+  Require(value.number == std::floor(value.number) && value.number >= static_cast<double>(min) &&
+              value.number <= static_cast<double>(max),
+          where,
+          "key \"" + key + "\" must be an integer in [" + std::to_string(min) + ", " +
+              std::to_string(max) + "]");
+  return static_cast<long>(value.number);
+}
+
+// Sets the field of `fields` named `key` to convert(); false when none has that name.
+template <typename Field, typename Convert>
+bool AssignNamed(const std::vector<std::pair<const char*, Field FrameStats::*>>& fields,
+                 const std::string& key, FrameStats* stats, Convert convert) {
+  for (const auto& [name, field] : fields) {
+    if (key != name) continue;
+    stats->*field = convert();
+    return true;
+  }
+  return false;
+}
+
+// Fills the field named `key`; false when no field has that name.
+bool AssignField(const std::string& key, const FlatJsonValue& value, const std::string& where,
+                 FrameStats* stats) {
+  using Kind = FlatJsonValue::Kind;
+  static const StatsFields fields;
+  const auto text = [&] {
+    RequireKind(value, Kind::kString, where, key, "a string");
+    return value.text;
+  };
+  const auto real = [&] {
+    Require(value.kind == Kind::kNumber || value.kind == Kind::kNull, where,
+            "key \"" + key + "\" must be a number or null");
+    return value.kind == Kind::kNull ? std::nan("") : value.number;
+  };
+  const auto whole_int = [&] {
+    return static_cast<int>(ReadWholeNumber(value, where, key, std::numeric_limits<int>::min(),
+                                            std::numeric_limits<int>::max()));
+  };
+  // 2^53: the largest range in which every whole double is exact.
+  const auto whole_long = [&] { return ReadWholeNumber(value, where, key, -(1L << 53), 1L << 53); };
+  const auto boolean = [&] {
+    RequireKind(value, Kind::kBool, where, key, "true or false");
+    return value.boolean;
+  };
+  const auto texts = [&] {
+    RequireKind(value, Kind::kStringList, where, key, "a list of strings");
+    return value.texts;
+  };
+  return AssignNamed(fields.strings, key, stats, text) ||
+         AssignNamed(fields.reals, key, stats, real) ||
+         AssignNamed(fields.ints, key, stats, whole_int) ||
+         AssignNamed(fields.longs, key, stats, whole_long) ||
+         AssignNamed(fields.bools, key, stats, boolean) ||
+         AssignNamed(fields.lists, key, stats, texts);
+}
+
+}  // namespace
+
+FrameStats ParseFrameStats(const std::string& line, const std::string& where) {
+  FrameStats stats;
+  bool has_frame = false;
+  for (const auto& [key, value] : internal::ParseFlatJsonObject(line, where)) {
+    Require(AssignField(key, value, where, &stats), where, "unknown key \"" + key + "\"");
+    has_frame = has_frame || key == "frame";
+  }
+  Require(has_frame, where, "missing key \"frame\"");
+  return stats;
 }
 
 }  // namespace finecap

@@ -33,20 +33,6 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
 
 }  // namespace
 
-void RefineOptions::Check() const {
-  Require(subdivision_levels >= 0 && subdivision_levels <= 4, "model.subdivision_levels",
-          "must lie in [0, 4]");
-  Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
-  Require(reference_colors == "pixels" || reference_colors == "image_model",
-          "model.reference_colors", "must be pixels or image_model");
-  image.Check();
-  visibility.Check();
-  energy.Check();
-  solver.Check();
-  sweep.Check();
-  coarse_to_fine.Check();
-}
-
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
     : stencil_(BuildLoopSubdivision(first_coarse, options.subdivision_levels, where)),
@@ -120,11 +106,6 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
                                                options.energy);
   frame.seconds = SecondsSince(start);
   return frame;
-}
-
-void CoarseToFineOptions::Check() const {
-  Require(levels >= 1 && levels <= 5, "refine.coarse_to_fine.levels", "must lie in [1, 5]");
-  Require(scale > 1.0 && scale <= 4.0, "refine.coarse_to_fine.scale", "must lie in (1, 4]");
 }
 
 namespace {
@@ -204,7 +185,8 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   }
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
-  result.kept_input = result.worse && options.keep_input_if_worse;
+  // With no surface Gaussian (no camera sees a refined vertex) the input is all there is.
+  result.kept_input = (result.worse && options.keep_input_if_worse) || k.size() == 0;
 
   const double bias = options.bias_compensation ? options.sigma_hat : 0.0;
   result.refined = frame.fine;

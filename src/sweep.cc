@@ -6,10 +6,6 @@
 
 namespace finecap {
 
-void SweepOptions::Check() const {
-  Require(samples == 0 || samples >= 3, "solver.sweep_samples", "must be 0 (off) or at least 3");
-  Require(smoothing_rounds >= 0, "solver.sweep_smoothing_rounds", "must be non-negative");
-}
 
 namespace {
 

@@ -2,6 +2,9 @@
 #ifndef FINECAP_TESTS_TINY_SYNTH_H_
 #define FINECAP_TESTS_TINY_SYNTH_H_
 
+#include <string>
+
+#include "finecap/config.h"
 #include "finecap/synth.h"
 
 namespace finecap {
@@ -23,6 +26,18 @@ inline SynthOptions TinySynthOptions() {
   options.render.supersampling = 1;
   options.fold_ramp_frames = 0;
   return options;
+}
+
+// A config that refines `capture` into `out` quickly: one thread, few iterations.
+inline Config TinyRunConfig(const std::string& capture, const std::string& out,
+                            int max_iterations) {
+  Config config;
+  config.capture.dir = capture;
+  config.output.dir = out;
+  config.runtime.threads = 1;
+  config.refine.solver.max_iterations = max_iterations;
+  config.refine.solver.num_threads = 1;
+  return config;
 }
 
 }  // namespace testing_util

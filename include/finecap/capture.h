@@ -54,6 +54,8 @@ class Capture {
   int num_frames() const { return static_cast<int>(frame_names_.size()); }
   const std::string& frame_name(int frame) const;
   const std::vector<std::string>& frame_names() const { return frame_names_; }
+  // The coarse mesh file of `frame`, for messages about it.
+  const std::string& mesh_path(int frame) const;
 
   // The coarse mesh of `frame`, validated and with the topology of frame 0. Throws Error naming
   // the file otherwise.

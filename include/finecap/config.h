@@ -22,6 +22,11 @@ struct CaptureConfig {
   std::string dir;
   // Frames to process, "A:B" = indices A to B-1 of the sorted frame list; "" = all frames.
   std::string frames;
+  // When a camera's image of a frame cannot be read (missing, empty, truncated, undecodable, of
+  // the wrong size, past the end of its video), refine the frame without that camera, with a
+  // warning, and list it in the frame's stats record (skipped_cameras). The first frame's images
+  // are checked when the capture opens and are never skipped. Default false: stop with an error.
+  bool skip_unreadable_cameras = false;
 };
 
 // Where the results go.

@@ -4,6 +4,7 @@
 #define FINECAP_FRAME_STATS_H_
 
 #include <string>
+#include <vector>
 
 #include "finecap/refine.h"
 
@@ -37,6 +38,9 @@ struct FrameStats {
   // The same over the textureless region (NaN when the capture marks none).
   double rms_textureless_coarse_mm = 0.0;
   double rms_textureless_refined_mm = 0.0;
+  // Cameras left out of this frame because their image could not be read
+  // (capture.skip_unreadable_cameras); empty when every camera was used.
+  std::vector<std::string> skipped_cameras;
 };
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
@@ -44,6 +48,13 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
 
 // One line of JSON (no newline). Non-finite numbers are written as null.
 std::string ToJson(const FrameStats& stats);
+
+// The inverse of ToJson: one stats record (a line of stats.jsonl, with or without its newline).
+// null reads as NaN for the real-valued fields. A key that ToJson does not write, a value of the
+// wrong type, an integer out of range or malformed JSON throws Error(where, ...) naming the key or
+// the character; a missing key keeps its default (records of older versions lack newer keys),
+// except "frame", which is required. Numbers come back as ToJson rounded them (10 digits).
+FrameStats ParseFrameStats(const std::string& line, const std::string& where);
 
 }  // namespace finecap
 

@@ -152,7 +152,8 @@ struct FrameResult {
   Eigen::VectorXd k_solved;  // Per surface Gaussian, as solved (for warm starts).
   SolverSummary summary;
   bool worse = false;       // The solve ended with a lower energy than it started from.
-  bool kept_input = false;  // The input surface was written instead (keep_input_if_worse).
+  bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
+                            // camera sees any refined vertex).
   int num_surface_gaussians = 0;
   long num_image_gaussians = 0;
   long num_pairs = 0;

@@ -55,12 +55,30 @@ std::string RefinedRunFolder(const Config& config) {
 }
 
 FrameInput ReadFrameInput(Capture* capture, int frame) {
+  return ReadFrameInput(capture, frame, false, nullptr);
+}
+
+FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
+                          std::vector<std::string>* skipped) {
   FrameInput input;
   input.coarse = capture->ReadCoarseMesh(frame);
-  input.cameras = capture->cameras();
+  std::string first_error;
   for (int c = 0; c < capture->num_cameras(); ++c) {
-    input.images.push_back(capture->ReadImage(c, frame));
+    const Camera& camera = capture->cameras()[c];
+    try {
+      input.images.push_back(capture->ReadImage(c, frame));
+      input.cameras.push_back(camera);
+    } catch (const Error& error) {
+      if (!skip_unreadable) throw;
+      if (first_error.empty()) first_error = error.what();
+      std::cerr << "finecap: warning: frame " << capture->frame_name(frame) << " without camera "
+                << camera.name << " (capture.skip_unreadable_cameras): " << error.what() << "\n";
+      if (skipped != nullptr) skipped->push_back(camera.name);
+    }
   }
+  Require(!input.cameras.empty(), "",
+          first_error + " (and no other camera's image of frame " + capture->frame_name(frame) +
+              " could be read either)");
   return input;
 }
 
@@ -83,7 +101,8 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
           "frame " + std::to_string(config.reference_frame) + " does not exist in " +
               capture->directory());
-  const FrameInput reference = ReadFrameInput(capture, config.reference_frame);
+  const FrameInput reference = ReadFrameInput(capture, config.reference_frame,
+                                              config.capture.skip_unreadable_cameras, nullptr);
   const ReferenceColors colors = ComputeSequenceColors(model, reference, config.refine);
   WriteReferenceColors(path, colors);
   return colors;

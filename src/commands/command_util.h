@@ -30,6 +30,12 @@ std::string RefinedRunFolder(const Config& config);
 // The coarse mesh, cameras and undistorted images of one frame.
 FrameInput ReadFrameInput(Capture* capture, int frame);
 
+// The same, except that with `skip_unreadable` a camera whose image cannot be read is left out of
+// the frame (with a warning on stderr) and its name appended to `*skipped` (which may be null
+// otherwise). When no camera's image can be read, the first camera's error is thrown.
+FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
+                          std::vector<std::string>* skipped);
+
 // The reference colours saved in `path`, or, when there is no such file, those of the
 // configured reference frame, computed and saved there.
 ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,

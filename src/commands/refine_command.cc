@@ -11,6 +11,7 @@
 #include "finecap/frame_stats.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
+#include "finecap/scene_scale.h"
 #include "finecap/solver_trace.h"
 
 namespace finecap {
@@ -99,12 +100,14 @@ void PrintProblemSize(const Capture& capture, const SequenceModel& model, int fr
 int RunRefine(const Config& config) {
   Capture capture = internal::OpenConfiguredCapture(config);
   const FrameRange frames = internal::ConfiguredFrames(config, capture);
+  RequirePlausibleSceneScale(capture.ReadCoarseMesh(0), config.refine.sigma_hat,
+                             capture.mesh_path(0));
   const std::string out = internal::PrepareOutputFolder(config, capture);
   for (const char* folder : {"meshes", "k", "frames", "traces"})
     fs::create_directories(out + "/" + folder);
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
-                            capture.directory() + "/meshes");
+                            capture.mesh_path(0));
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
   const Regions regions = SplitByTexture(model, capture);
@@ -122,13 +125,21 @@ int RunRefine(const Config& config) {
       continue;
     }
     const auto start = std::chrono::steady_clock::now();
-    const FrameInput input = internal::ReadFrameInput(&capture, frame);
+    std::vector<std::string> skipped;
+    const FrameInput input =
+        internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
     const bool warm = config.refine.warm_start && previous_k.size() > 0;
     FrameResult result =
         RefineFrame(model, colors, input, config.refine, warm ? &previous_k : nullptr);
     previous_k = result.k_solved;
+    if (result.num_surface_gaussians == 0) {
+      std::cerr << "finecap refine: warning: frame " << name
+                << ": no camera sees any vertex to refine (the mesh is behind every camera or "
+                   "out of view); the input surface is written\n";
+    }
 
     FrameStats stats = MakeFrameStats(name, config.refine, result);
+    stats.skipped_cameras = skipped;
     AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
     WriteMesh(paths.mesh, result.refined, {result.normals, {}, quality},

@@ -5,23 +5,6 @@
 
 namespace finecap {
 
-void SolverOptions::Check() const {
-  Require(type == "ceres" || type == "gradient_ascent" || type == "lbfgs", "solver.type",
-          "'" + type + "' is not one of: ceres, gradient_ascent, lbfgs");
-  Require(max_iterations >= 0, "solver.max_iterations", "must be non-negative");
-  Require(function_tolerance >= 0.0, "solver.function_tolerance", "must be non-negative");
-  Require(num_threads >= 0, "solver.num_threads", "must be non-negative");
-  Require(trust_region == "levenberg_marquardt" || trust_region == "dogleg", "solver.trust_region",
-          "'" + trust_region + "' is not one of: levenberg_marquardt, dogleg");
-  Require(linear_solver == "sparse_normal_cholesky" || linear_solver == "cgnr" ||
-              linear_solver == "dense_qr",
-          "solver.linear_solver",
-          "'" + linear_solver + "' is not one of: sparse_normal_cholesky, cgnr, dense_qr");
-  Require(initial_step > 0.0, "solver.initial_step", "must be positive");
-  Require(step_growth >= 1.0, "solver.step_growth", "must be at least 1");
-  Require(step_shrink > 0.0 && step_shrink < 1.0, "solver.step_shrink", "must lie in (0, 1)");
-  Require(max_step > 0.0, "solver.max_step", "must be positive");
-}
 
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
   SimilarityTerm& similarity = energy->similarity();
