@@ -1,10 +1,9 @@
 #include "finecap/comparison.h"
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <sstream>
-
-#include <yaml-cpp/yaml.h>
 
 #include "finecap/error.h"
 #include "finecap/metrics.h"
@@ -13,36 +12,6 @@ namespace finecap {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-YAML::Node Field(const YAML::Node& record, const char* name, const std::string& path) {
-  const YAML::Node value = record[name];
-  Require(value.IsDefined(), path, std::string("the record has no field '") + name + "'");
-  return value;
-}
-
-double NumberField(const YAML::Node& record, const char* name, const std::string& path) {
-  const YAML::Node value = Field(record, name, path);
-  if (value.IsNull()) return kNaN;  // Written for a non-finite number.
-  try {
-    return value.as<double>();
-  } catch (const YAML::Exception&) {
-    throw Error(path, std::string("field '") + name + "' is not a number");
-  }
-}
-
-std::string TextField(const YAML::Node& record, const char* name, const std::string& path) {
-  const YAML::Node value = Field(record, name, path);
-  Require(value.IsScalar(), path, std::string("field '") + name + "' is not text");
-  return value.Scalar();
-}
-
-bool BoolField(const YAML::Node& record, const char* name, const std::string& path) {
-  try {
-    return Field(record, name, path).as<bool>();
-  } catch (const YAML::Exception&) {
-    throw Error(path, std::string("field '") + name + "' is not true or false");
-  }
-}
 
 double Mean(const std::vector<double>& values) {
   double sum = 0.0;
@@ -105,35 +74,11 @@ double Value(const NumberColumn& column, const VariantSummary& row) {
 }  // namespace
 
 FrameStats ReadFrameStats(const std::string& path) {
-  YAML::Node record;
-  try {
-    record = YAML::LoadFile(path);  // JSON is YAML.
-  } catch (const YAML::BadFile&) {
-    throw Error(path, "cannot open the statistics record");
-  } catch (const YAML::Exception& error) {
-    throw Error(path, "malformed statistics record: " + error.msg);
-  }
-  Require(record.IsMap(), path, "a statistics record is one JSON object");
-  FrameStats stats;
-  stats.frame = TextField(record, "frame", path);
-  stats.solver = TextField(record, "solver", path);
-  stats.similarity = TextField(record, "similarity", path);
-  stats.energy_start = NumberField(record, "energy_start", path);
-  stats.energy_end = NumberField(record, "energy_end", path);
-  stats.ls_cost_start = NumberField(record, "ls_cost_start", path);
-  stats.ls_cost_end = NumberField(record, "ls_cost_end", path);
-  stats.iterations = static_cast<int>(NumberField(record, "iterations", path));
-  stats.evaluations = static_cast<int>(NumberField(record, "evaluations", path));
-  stats.seconds = NumberField(record, "seconds", path);
-  stats.seconds_solve = NumberField(record, "seconds_solve", path);
-  stats.seconds_evaluation = NumberField(record, "seconds_evaluation", path);
-  stats.seconds_linear_solver = NumberField(record, "seconds_linear_solver", path);
-  stats.worse = BoolField(record, "worse", path);
-  stats.kept_input = BoolField(record, "kept_input", path);
-  stats.rms_coarse_mm = NumberField(record, "rms_coarse_mm", path);
-  stats.rms_refined_mm = NumberField(record, "rms_refined_mm", path);
-  stats.rms_textureless_refined_mm = NumberField(record, "rms_textureless_refined_mm", path);
-  return stats;
+  std::ifstream file(path);
+  Require(file.good(), path, "cannot open the statistics record");
+  std::string line;
+  std::getline(file, line);
+  return ParseFrameStats(line, path);
 }
 
 VariantSummary SummarizeVariant(const std::string& name, const std::vector<FrameStats>& frames,

@@ -155,8 +155,8 @@ TEST(ComparisonTest, FrameStatsReadBackWhatRefineWrites) {
   EXPECT_EQ(read.evaluations, 6);
   EXPECT_TRUE(read.kept_input);
   EXPECT_TRUE(std::isnan(read.rms_textureless_refined_mm));  // Written as null.
-  WriteText(dir + "/short.json", "{\"frame\": \"1\", \"solver\": \"ceres\"}\n");
-  ExpectErrorMentions([&] { ReadFrameStats(dir + "/short.json"); }, {"short.json", "similarity"});
+  WriteText(dir + "/bad.json", "{\"frame\": \"1\", \"solver\": 3}\n");
+  ExpectErrorMentions([&] { ReadFrameStats(dir + "/bad.json"); }, {"bad.json", "solver"});
   ExpectErrorMentions([&] { ReadFrameStats(dir + "/none.json"); }, {"none.json", "cannot open"});
 }
 
