@@ -1,5 +1,7 @@
 #include "finecap/frame_stats.h"
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <sstream>
 
@@ -9,6 +11,12 @@ namespace finecap {
 
 using internal::JsonNumber;
 using internal::JsonString;
+
+double PeakResidentMegabytes() {
+  rusage usage = {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes.
+}
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result) {
@@ -36,6 +44,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.kept_input = result.kept_input;
   stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
   stats.rms_textureless_coarse_mm = stats.rms_textureless_refined_mm = std::nan("");
+  stats.peak_rss_mb = PeakResidentMegabytes();
   return stats;
 }
 
@@ -61,7 +70,8 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
-       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm) << "}";
+       << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
+       << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << "}";
   return json.str();
 }
 

@@ -1,6 +1,8 @@
 #include "finecap/refine.h"
 
 #include <chrono>
+#include <cmath>
+#include <functional>
 
 #include "finecap/error.h"
 #include "finecap/frame_energy.h"
@@ -119,9 +121,14 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
   return frame;
 }
 
-FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
-                        const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start) {
+namespace {
+
+// The starting k of the surface Gaussians of a prepared frame, given the default start `k`.
+using StartOverride = std::function<void(const FrameEnergy& energy, Eigen::VectorXd* k)>;
+
+FrameResult SolveFrame(const SequenceModel& model, const ReferenceColors& colors,
+                       const FrameInput& input, const RefineOptions& options,
+                       const StartOverride& override_start) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame = PrepareFrame(model, colors, input, options);
   FrameEnergy& energy = *frame.energy;
@@ -132,7 +139,7 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.seconds_preparation = frame.seconds;
 
   Eigen::VectorXd k = SweepInitialization(&energy, options.sweep);
-  if (warm_start != nullptr && warm_start->size() == k.size()) k = *warm_start;
+  override_start(energy, &k);
   result.summary = Solve(&energy, options.solver, &k);
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
@@ -150,6 +157,33 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.normals = ComputeVertexNormals(result.refined);
   result.seconds_total = SecondsSince(start);
   return result;
+}
+
+}  // namespace
+
+FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
+                        const FrameInput& input, const RefineOptions& options,
+                        const Eigen::VectorXd* warm_start) {
+  return SolveFrame(model, colors, input, options,
+                    [warm_start](const FrameEnergy&, Eigen::VectorXd* k) {
+                      if (warm_start != nullptr && warm_start->size() == k->size())
+                        *k = *warm_start;
+                    });
+}
+
+FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
+                            const FrameInput& input, const RefineOptions& options,
+                            const Eigen::VectorXd& start) {
+  Require(start.size() == model.num_fine_vertices(), "refine",
+          "a start of " + std::to_string(start.size()) + " displacements for " +
+              std::to_string(model.num_fine_vertices()) + " fine vertices");
+  return SolveFrame(model, colors, input, options,
+                    [&start](const FrameEnergy& energy, Eigen::VectorXd* k) {
+                      const std::vector<int>& ids = energy.surface().vertex_ids;
+                      for (size_t s = 0; s < ids.size(); ++s) {
+                        if (std::isfinite(start[ids[s]])) (*k)[s] = start[ids[s]];
+                      }
+                    });
 }
 
 }  // namespace finecap

@@ -37,7 +37,13 @@ struct FrameStats {
   // The same over the textureless region (NaN when the capture marks none).
   double rms_textureless_coarse_mm = 0.0;
   double rms_textureless_refined_mm = 0.0;
+  // The process's peak resident memory when the frame was done (getrusage's ru_maxrss), MB of
+  // 2^20 bytes. Over a long run it should stay flat: nothing grows with the frames.
+  double peak_rss_mb = 0.0;
 };
+
+// The peak resident memory of this process so far, MB of 2^20 bytes (getrusage's ru_maxrss).
+double PeakResidentMegabytes();
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result);
