@@ -15,13 +15,16 @@ cd "$(dirname "$0")/.."
 repo=$(pwd)
 
 skip() { echo "SKIPPED: $*"; exit 0; }
-as_root() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo -n "$@"; fi; }
+# A command prefix that runs as root. Not a function: a command started in the background through
+# it must have the daemon's own pid in $!, to be stopped by it.
+as_root=()
+[ "$(id -u)" = 0 ] || as_root=(sudo -n)
 
 if [ "$(id -u)" != 0 ] && ! sudo -n true 2>/dev/null; then skip "needs root or sudo"; fi
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null ||
   ! command -v munged >/dev/null || ! command -v sbatch >/dev/null; then
-  as_root apt-get update >/dev/null 2>&1 || skip "apt-get update failed"
-  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
+  "${as_root[@]}" apt-get update >/dev/null 2>&1 || skip "apt-get update failed"
+  "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends \
     slurm-wlm munge >/dev/null 2>&1 || skip "cannot install slurm-wlm and munge"
 fi
 [ -x build/finecap ] || bash scripts/build.sh >/dev/null
@@ -29,12 +32,15 @@ fi
 work=$(mktemp -d /tmp/finecap-slurm.XXXXXX)
 chmod 755 "$work"
 pids=()
+jobs=""
 cleanup() {
-  for pid in "${pids[@]}"; do as_root kill "$pid" 2>/dev/null || true; done
+  # Jobs still queued or running when the wait ran out, then the daemons.
+  for job in $(echo "$jobs" | sed -n 's/^[a-z_]*: //p'); do timeout 5 scancel "$job" 2>/dev/null || true; done
+  for pid in "${pids[@]}"; do "${as_root[@]}" kill "$pid" 2>/dev/null || true; done
   for pid in "${pids[@]}"; do
-    for _ in $(seq 50); do as_root kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+    for _ in $(seq 50); do "${as_root[@]}" kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
   done
-  as_root rm -rf "$work"
+  "${as_root[@]}" rm -rf "$work"
 }
 trap cleanup EXIT
 
@@ -43,7 +49,7 @@ mkdir -p "$work/munge"
 chmod 700 "$work/munge"
 head -c 1024 /dev/urandom > "$work/munge/munge.key"
 chmod 400 "$work/munge/munge.key"
-as_root munged --force --key-file="$work/munge/munge.key" --socket="$work/munge/munge.sock" \
+"${as_root[@]}" munged --force --key-file="$work/munge/munge.key" --socket="$work/munge/munge.sock" \
   --pid-file="$work/munge/munged.pid" --log-file="$work/munge/munged.log" \
   --seed-file="$work/munge/munged.seed" || skip "munged does not start: $(cat "$work/munge/munged.log" 2>/dev/null)"
 for _ in $(seq 50); do [ -s "$work/munge/munged.pid" ] && break; sleep 0.1; done
@@ -83,15 +89,15 @@ MinJobAge=600
 NodeName=$node NodeAddr=127.0.0.1 CPUs=2 State=UNKNOWN
 PartitionName=test Nodes=$node Default=YES MaxTime=INFINITE State=UP
 CONF
-as_root env SLURM_CONF="$SLURM_CONF" slurmctld -D -i > "$work/slurmctld.out" 2>&1 &
+"${as_root[@]}" slurmctld -D -i -f "$SLURM_CONF" > "$work/slurmctld.out" 2>&1 &
 pids+=($!)
-as_root env SLURM_CONF="$SLURM_CONF" slurmd -D -N "$node" > "$work/slurmd.out" 2>&1 &
+"${as_root[@]}" slurmd -D -N "$node" -f "$SLURM_CONF" > "$work/slurmd.out" 2>&1 &
 pids+=($!)
 ready=no
 for _ in $(seq 60); do
   if timeout 5 sinfo -h -N -o %t 2>/dev/null | grep -qx idle; then ready=yes; break; fi
   # A daemon that exited will not come back: no point in waiting.
-  for pid in "${pids[@]}"; do as_root kill -0 "$pid" 2>/dev/null || break 2; done
+  for pid in "${pids[@]}"; do "${as_root[@]}" kill -0 "$pid" 2>/dev/null || break 2; done
   sleep 1
 done
 if [ "$ready" != yes ]; then
