@@ -35,18 +35,6 @@ using testing_util::MakeTempDir;
 
 constexpr int kFrames = 4;
 
-// 3 cameras of 96 x 96 that see the skirt large, a 16 x 8 skirt, kFrames frames.
-SynthOptions ResumeCapture() {
-  SynthOptions options = testing_util::TinySynthOptions();
-  options.num_frames = kFrames;
-  options.skirt.down = 8;
-  options.cameras.count = 3;
-  options.cameras.width = 96;
-  options.cameras.height = 96;
-  options.cameras.focal = 300.0;
-  return options;
-}
-
 // The arguments of every run: one thread, so that runs are repeatable to the last bit.
 std::vector<std::string> RefineArguments(const std::string& capture, const std::string& out) {
   return {FINECAP_BINARY, "refine",
@@ -175,7 +163,7 @@ class ResumeTest : public ::testing::Test {
   // One capture and one uninterrupted run for all tests.
   static void SetUpTestSuite() {
     root_ = new std::string(MakeTempDir("resume"));
-    GenerateSyntheticCapture(ResumeCapture(), capture());
+    GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(kFrames), capture());
     ASSERT_EQ(RunToEnd(RefineArguments(capture(), reference())), 0);
   }
   static void TearDownTestSuite() {
