@@ -240,5 +240,38 @@ TEST_F(ResumeTest, TwoShardsOneAfterTheOtherEqualOneRun) {
   EXPECT_NE(::testing::internal::GetCapturedStdout().find("4 of 4 frames done"), std::string::npos);
 }
 
+// The frame names of the records in `path`, in order.
+std::vector<std::string> RecordFrames(const std::string& path) {
+  std::istringstream lines(FileBytes(path));
+  std::vector<std::string> frames;
+  std::string line;
+  while (std::getline(lines, line)) frames.push_back(line.substr(11, 6));  // {"frame": "......"
+  return frames;
+}
+
+TEST_F(ResumeTest, ShardsInReverseOrderLeaveTheRecordsInFrameOrder) {
+  Config config;
+  config.capture.dir = capture();
+  config.output.dir = *root_ + "/reverse";
+  config.runtime.threads = 1;
+  config.refine.solver.num_threads = 1;
+  config.refine.solver.max_iterations = 2;
+  config.runtime.shard = {1, 2};
+  ASSERT_EQ(RunRefine(config), 0);
+  EXPECT_EQ(RecordFrames(config.output.dir + "/stats.jsonl"),
+            (std::vector<std::string>{"000002", "000003"}));
+  config.runtime.shard = {0, 2};
+  ASSERT_EQ(RunRefine(config), 0);
+  EXPECT_EQ(RecordFrames(config.output.dir + "/stats.jsonl"),
+            (std::vector<std::string>{"000000", "000001", "000002", "000003"}));
+  ExpectNoPartialFile(config.output.dir);
+
+  // More shards than frames: a shard without frames succeeds and writes none.
+  config.output.dir = *root_ + "/empty_shard";
+  config.runtime.shard = {5, 8};
+  ASSERT_EQ(RunRefine(config), 0);
+  EXPECT_TRUE(FilesIn(config.output.dir + "/frames").empty());
+}
+
 }  // namespace
 }  // namespace finecap
