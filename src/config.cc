@@ -101,6 +101,18 @@ void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
                     "Weight of a pull of k towards the input surface (not in the paper); keeps "
                     "textureless regions in place.",
                     0.0, 1e12);
+  schema->AddDouble("energy.confidence_prior", &energy->confidence_prior,
+                    "Strength of a pull of k towards the input surface on wide plain regions of "
+                    "the cloth, in units of the median data curvature (not in the paper; 0: off).",
+                    0.0, 1e6);
+  schema->AddDouble("energy.confidence_threshold", &energy->confidence_threshold,
+                    "Colour variation, as a fraction of its median, below which the cloth counts "
+                    "as plain.",
+                    1e-9, 1e3);
+  schema->AddInt("energy.confidence_opening", &energy->confidence_opening,
+                 "Passes of the opening of the plain region: narrower plain patches are left to "
+                 "the regulariser.",
+                 0, 20);
   schema->AddInt("energy.reg_rings", &energy->reg_rings,
                  "Regulariser neighbourhood Delta in edges, also its Wendland cut-off (paper: 2).",
                  1, 10);
@@ -144,6 +156,14 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                   "Write the input surface for a frame whose energy got worse (always flagged).");
   schema->AddBool("refine.warm_start", &refine->warm_start,
                   "Start each frame from the previous frame's displacement.");
+  schema->AddInt("refine.coarse_to_fine.levels", &refine->coarse_to_fine.levels,
+                 "Levels of a coarse-to-fine schedule per frame (wider Gaussians and a coarser "
+                 "image model first); 1: off.",
+                 1, 5);
+  schema->AddDouble("refine.coarse_to_fine.scale", &refine->coarse_to_fine.scale,
+                    "Factor of sigma_hat and of the smallest quad-tree leaf from one level to the "
+                    "next coarser.",
+                    1.0001, 4.0);
 }
 
 }  // namespace

@@ -62,6 +62,15 @@ std::string Join(const std::vector<std::string>& items, const std::string& separ
   return joined;
 }
 
+// The shortest text that reads back as the same double's neighbourhood: 0.05, not
+// 0.050000000000000003 (yaml-cpp writes 17 significant digits).
+std::string DoubleText(double value) {
+  std::ostringstream text;
+  text.precision(15);
+  text << value;
+  return text.str();
+}
+
 std::string DoubleListText(const std::vector<double>& values) {
   std::ostringstream text;
   text << "[";
@@ -106,7 +115,7 @@ void ConfigSchema::AddDouble(const std::string& path, double* field, const std::
             RequireInRange(number, min, max, where);
             *field = number;
           },
-          [=] { return YAML::Node(*field).as<std::string>(); }});
+          [=] { return DoubleText(*field); }});
 }
 
 void ConfigSchema::AddBool(const std::string& path, bool* field, const std::string& doc) {

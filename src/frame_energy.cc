@@ -1,6 +1,7 @@
 #include "finecap/frame_energy.h"
 
 #include "finecap/error.h"
+#include "finecap/input_prior.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
 
@@ -15,6 +16,9 @@ void EnergyOptions::Check() const {
   Require(k_max > 0.0, "energy.k_max", "must be positive");
   Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
   Require(w_prior >= 0.0, "energy.w_prior", "must be non-negative");
+  Require(confidence_prior >= 0.0, "energy.confidence_prior", "must be non-negative");
+  Require(confidence_threshold > 0.0, "energy.confidence_threshold", "must be positive");
+  Require(confidence_opening >= 0, "energy.confidence_opening", "must be non-negative");
   Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
   Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
 }
@@ -64,7 +68,16 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
       views_(BuildViews(surface_, cameras, options_)),
       similarity_(MakeSimilarity(surface_, views_, options_)),
       regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
-                   options_.RegUnitScale()) {}
+                   options_.RegUnitScale()) {
+  // The data curvature is measured once, at the input surface, so that the prior is a fixed
+  // quadratic: the solvers see one energy throughout.
+  Eigen::VectorXd data_curvature, plain_cloth;
+  if (options_.confidence_prior > 0.0) {
+    data_curvature = DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size()));
+    plain_cloth = PlainCloth(surface_, regularizer_, options_);
+  }
+  prior_curvature_ = PriorCurvature(data_curvature, plain_cloth, surface_.size(), options_);
+}
 
 long FrameEnergy::num_pairs() const {
   long pairs = 0;
@@ -77,14 +90,13 @@ double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient
   Eigen::VectorXd similarity_gradient, regularization_gradient;
   const double e_sim = similarity_->Evaluate(k, gradient ? &similarity_gradient : nullptr);
   const double e_reg = regularizer_.Evaluate(k, gradient ? &regularization_gradient : nullptr);
-  const double u2 = options_.RegUnitScale() * options_.RegUnitScale();
   if (gradient != nullptr) {
     *gradient = similarity_gradient - options_.w_reg * regularization_gradient -
-                2.0 * options_.w_prior * u2 * k;
+                prior_curvature_.cwiseProduct(k);
   }
   if (similarity != nullptr) *similarity = e_sim;
   if (regularization != nullptr) *regularization = e_reg;
-  return e_sim - options_.w_reg * e_reg - options_.w_prior * u2 * k.squaredNorm();
+  return e_sim - options_.w_reg * e_reg - 0.5 * k.dot(prior_curvature_.cwiseProduct(k));
 }
 
 }  // namespace finecap

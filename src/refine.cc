@@ -1,5 +1,6 @@
 #include "finecap/refine.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -44,6 +45,7 @@ void RefineOptions::Check() const {
   energy.Check();
   solver.Check();
   sweep.Check();
+  coarse_to_fine.Check();
 }
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
@@ -121,26 +123,83 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
   return frame;
 }
 
+void CoarseToFineOptions::Check() const {
+  Require(levels >= 1 && levels <= 5, "refine.coarse_to_fine.levels", "must lie in [1, 5]");
+  Require(scale > 1.0 && scale <= 4.0, "refine.coarse_to_fine.scale", "must lie in (1, 4]");
+}
+
 namespace {
 
-// The starting k of the surface Gaussians of a prepared frame, given the default start `k`.
-using StartOverride = std::function<void(const FrameEnergy& energy, Eigen::VectorXd* k)>;
+// Where the solve of a prepared frame starts: one k per surface Gaussian of `energy`.
+using StartingPointFunction = std::function<Eigen::VectorXd(FrameEnergy* energy)>;
 
-FrameResult SolveFrame(const SequenceModel& model, const ReferenceColors& colors,
-                       const FrameInput& input, const RefineOptions& options,
-                       const StartOverride& override_start) {
+// Level `level` of the coarse-to-fine schedule (0: the configured options): wider surface
+// Gaussians and larger image Gaussians, so that the energy is smoother in k and a fold further
+// than a Gaussian's width from the input surface is still within reach.
+RefineOptions LevelOptions(const RefineOptions& options, int level) {
+  RefineOptions level_options = options;
+  const double factor = std::pow(options.coarse_to_fine.scale, level);
+  level_options.sigma_hat *= factor;
+  level_options.image.min_leaf_size =
+      std::max(1, static_cast<int>(std::lround(options.image.min_leaf_size * factor)));
+  return level_options;
+}
+
+// The coarse levels of the schedule, coarsest first, each starting where the last one ended.
+// Returns the k to start the configured level from; adds the work done to *totals.
+Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const StartingPointFunction& starting_point,
+                                  SolverSummary* totals, double* seconds_preparation) {
+  Eigen::VectorXd k;
+  for (int level = options.coarse_to_fine.levels - 1; level >= 1; --level) {
+    const RefineOptions level_options = LevelOptions(options, level);
+    ReferenceColors level_colors = colors;
+    level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
+    PreparedFrame frame = PrepareFrame(model, level_colors, input, level_options);
+    *seconds_preparation += frame.seconds;
+    if (k.size() == 0) k = starting_point(frame.energy.get());
+    const SolverSummary summary = Solve(frame.energy.get(), options.solver, &k);
+    totals->iterations += summary.iterations;
+    totals->evaluations += summary.evaluations;
+    totals->seconds += summary.seconds;
+    totals->seconds_evaluation += summary.seconds_evaluation;
+    totals->seconds_linear_solver += summary.seconds_linear_solver;
+  }
+  return k;
+}
+
+// RefineFrame, starting each level that does not continue from a coarser one at
+// `starting_point`.
+FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const StartingPointFunction& starting_point) {
   const auto start = std::chrono::steady_clock::now();
+  FrameResult result;
+  SolverSummary coarse;
+  const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
+                                                     &coarse, &result.seconds_preparation);
+
   PreparedFrame frame = PrepareFrame(model, colors, input, options);
   FrameEnergy& energy = *frame.energy;
-  FrameResult result;
   result.num_surface_gaussians = energy.num_parameters();
   result.num_image_gaussians = frame.num_image_gaussians;
   result.num_pairs = energy.num_pairs();
-  result.seconds_preparation = frame.seconds;
+  result.seconds_preparation += frame.seconds;
 
-  Eigen::VectorXd k = SweepInitialization(&energy, options.sweep);
-  override_start(energy, &k);
+  // The frame got worse or better against where it started, before any level moved it.
+  const Eigen::VectorXd initial = starting_point(&energy);
+  Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = Solve(&energy, options.solver, &k);
+  if (coarse_k.size() > 0) {
+    result.summary.energy_start = energy.Evaluate(initial, nullptr);
+    result.summary.ls_cost_start = LeastSquaresCost(&energy, initial);
+    result.summary.iterations += coarse.iterations;
+    result.summary.evaluations += coarse.evaluations;
+    result.summary.seconds += coarse.seconds;
+    result.summary.seconds_evaluation += coarse.seconds_evaluation;
+    result.summary.seconds_linear_solver += coarse.seconds_linear_solver;
+  }
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
   result.kept_input = result.worse && options.keep_input_if_worse;
@@ -161,14 +220,18 @@ FrameResult SolveFrame(const SequenceModel& model, const ReferenceColors& colors
 
 }  // namespace
 
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start) {
+  if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
+  return SweepInitialization(energy, sweep);
+}
+
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
                         const Eigen::VectorXd* warm_start) {
-  return SolveFrame(model, colors, input, options,
-                    [warm_start](const FrameEnergy&, Eigen::VectorXd* k) {
-                      if (warm_start != nullptr && warm_start->size() == k->size())
-                        *k = *warm_start;
-                    });
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    return StartingPoint(energy, options.sweep, warm_start);
+  });
 }
 
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
@@ -177,13 +240,14 @@ FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& c
   Require(start.size() == model.num_fine_vertices(), "refine",
           "a start of " + std::to_string(start.size()) + " displacements for " +
               std::to_string(model.num_fine_vertices()) + " fine vertices");
-  return SolveFrame(model, colors, input, options,
-                    [&start](const FrameEnergy& energy, Eigen::VectorXd* k) {
-                      const std::vector<int>& ids = energy.surface().vertex_ids;
-                      for (size_t s = 0; s < ids.size(); ++s) {
-                        if (std::isfinite(start[ids[s]])) (*k)[s] = start[ids[s]];
-                      }
-                    });
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    Eigen::VectorXd k = SweepInitialization(energy, options.sweep);
+    const std::vector<int>& ids = energy->surface().vertex_ids;
+    for (size_t s = 0; s < ids.size(); ++s) {
+      if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];
+    }
+    return k;
+  });
 }
 
 }  // namespace finecap

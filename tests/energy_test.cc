@@ -11,27 +11,6 @@
 namespace finecap {
 namespace {
 
-Eigen::VectorXd RandomK(int n, double amplitude, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Eigen::VectorXd k(n);
-  for (int s = 0; s < n; ++s) k[s] = amplitude * unit(rng);
-  return k;
-}
-
-// Central differences of a scalar function of k, one coordinate at a time.
-template <typename Function>
-Eigen::VectorXd NumericGradient(const Function& f, const Eigen::VectorXd& k, double h) {
-  Eigen::VectorXd gradient(k.size());
-  for (int s = 0; s < k.size(); ++s) {
-    Eigen::VectorXd plus = k, minus = k;
-    plus[s] += h;
-    minus[s] -= h;
-    gradient[s] = (f(plus) - f(minus)) / (2.0 * h);
-  }
-  return gradient;
-}
-
 EnergyOptions Options(const std::string& similarity, const std::string& overlap) {
   EnergyOptions options;
   options.similarity = similarity;

@@ -1,4 +1,5 @@
-// The energy of one frame, E(k) = E_sim(k) - w_reg * E_reg(k) (the paper's eq. 3), built from the
+// The energy of one frame, E(k) = E_sim(k) - w_reg * E_reg(k) (the paper's eq. 3) - E_prior(k)
+// (input_prior.h; zero unless configured), built from the
 // surface Gaussians, the cameras with their image Gaussians and visibility, and the mesh's
 // neighbourhoods. It owns the pair lists, so it is built once per frame and then evaluated many
 // times by a solver; it is neither copied nor moved (the terms refer to its members).
@@ -41,6 +42,8 @@ class FrameEnergy {
   SimilarityTerm& similarity() { return *similarity_; }
   const SimilarityTerm& similarity() const { return *similarity_; }
   const Regularizer& regularizer() const { return regularizer_; }
+  // p_s of E_prior = 1/2 sum_s p_s k_s^2 (input_prior.h), one entry per surface Gaussian.
+  const Eigen::VectorXd& prior_curvature() const { return prior_curvature_; }
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 
@@ -54,6 +57,7 @@ class FrameEnergy {
   std::vector<EnergyView> views_;
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;
+  Eigen::VectorXd prior_curvature_;
 };
 
 }  // namespace finecap

@@ -36,6 +36,20 @@ inline ImageGaussianOptions RefinementImageOptions() {
   return options;
 }
 
+// A coarse-to-fine schedule within each frame: the energy is solved first with wider surface
+// Gaussians and a coarser image model (sigma_hat and the smallest quad-tree leaf multiplied by
+// scale^level), each level starting where the coarser one ended. A wider Gaussian reaches a fold
+// further from the input surface before the fine level sharpens it; the paper names such local
+// maxima as its main limitation. The reference colours are the configured level's throughout.
+struct CoarseToFineOptions {
+  // Levels, the configured one included; 1 turns the schedule off. Default 1.
+  int levels = 1;
+  // Factor from one level to the next coarser one. Default 2.
+  double scale = 2.0;
+
+  void Check() const;
+};
+
 struct RefineOptions {
   // Loop subdivision levels applied to the coarse mesh before refinement (the paper subdivided
   // its 1.5k-2.5k-vertex meshes to 6k-10k vertices: 1 level). Default 1.
@@ -60,6 +74,7 @@ struct RefineOptions {
 
   // A plane-sweep search for each Gaussian's starting displacement (sweep.h); off by default.
   SweepOptions sweep;
+  CoarseToFineOptions coarse_to_fine;
 
   // The image model. Defaults differ from ImageGaussianOptions' (the paper's) in two measured
   // ways: leaves down to 2 px (sigma 1 px) keep the texture detail the colour residual needs,
@@ -145,12 +160,18 @@ struct FrameResult {
   double seconds_total = 0.0;        // The whole frame.
 };
 
-// Refines one frame. `warm_start` (may be null) is a previous frame's k_solved.
+// Where a frame's solve starts: `warm_start` when given and of the right size, else the plane
+// sweep's result (zero when the sweep is off).
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start);
+
+// Refines one frame, through the coarse-to-fine levels when configured. `warm_start` (may be
+// null) is a previous frame's k_solved.
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
                         const Eigen::VectorXd* warm_start = nullptr);
 
-// Refines one frame starting from `start`: one displacement per fine vertex, metres, as solved
+// RefineFrame, starting from `start`: one displacement per fine vertex, metres, as solved
 // (before bias compensation); NaN where there is none, and those vertices start where RefineFrame
 // would start them (at zero, or where the plane sweep puts them). This is how a frame is seeded
 // from another frame's saved result: a fine vertex keeps its id over the sequence, while the

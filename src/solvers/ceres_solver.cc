@@ -26,12 +26,11 @@ void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* probl
     problem->AddResidualBlock(new SimilarityBlockCost(term, b), nullptr, blocks);
   }
   const Regularizer& regularizer = energy->regularizer();
-  const double w_prior = energy->options().w_prior;
-  if (w_prior > 0.0) {
-    const double coefficient = std::sqrt(2.0 * w_prior) * energy->options().RegUnitScale();
-    for (int s = 0; s < k->size(); ++s) {
-      problem->AddResidualBlock(new RegularizerPairCost(coefficient, true), nullptr, &(*k)[s]);
-    }
+  const Eigen::VectorXd& prior = energy->prior_curvature();
+  for (int s = 0; s < k->size(); ++s) {
+    if (prior[s] <= 0.0) continue;
+    problem->AddResidualBlock(new RegularizerPairCost(std::sqrt(prior[s]), true), nullptr,
+                              &(*k)[s]);
   }
   const double w_reg = energy->options().w_reg;
   if (w_reg <= 0.0) return;

@@ -35,11 +35,11 @@ double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
     for (double r : residuals) sum_of_squares += r * r;
   }
   // The regulariser's residuals are 2 sqrt(w T) u (k_a - k_b): their half sum of squares is
-  // w_reg * E_reg; the prior's, sqrt(2 w_prior) u k_s, give w_prior E_prior.
-  const EnergyOptions& options = energy->options();
-  const double u = options.RegUnitScale();
-  return 0.5 * sum_of_squares + options.w_reg * energy->regularizer().Evaluate(k, nullptr) +
-         options.w_prior * u * u * k.squaredNorm();
+  // w_reg * E_reg; the prior's, sqrt(p_s) k_s, give E_prior.
+  const Eigen::VectorXd& prior = energy->prior_curvature();
+  return 0.5 * sum_of_squares +
+         energy->options().w_reg * energy->regularizer().Evaluate(k, nullptr) +
+         0.5 * k.dot(prior.cwiseProduct(k));
 }
 
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {

@@ -1,0 +1,52 @@
+// The pull of the displacements towards the input surface (k = 0), not in the paper:
+//
+//   E_prior(k) = 1/2 sum_s p_s k_s^2,   E = E_sim - w_reg E_reg - E_prior,
+//
+// with a curvature p_s per surface Gaussian. Where a plain cloth shows no texture, the colour
+// residuals do not change with k_s and only the regulariser decides it: it carries the
+// displacement of the textured surroundings into the plain region, which can be worse than the
+// input. A uniform pull (energy.w_prior) prevents that but costs detail wherever the images do
+// constrain k. The confidence pull (energy.confidence_prior) holds only Gaussians on wide plain
+// regions of the cloth, found from the reference colours, with a strength in the units of the
+// data's own curvature.
+#ifndef FINECAP_INPUT_PRIOR_H_
+#define FINECAP_INPUT_PRIOR_H_
+
+#include <Eigen/Core>
+
+#include "finecap/energy_options.h"
+#include "finecap/regularizer.h"
+#include "finecap/similarity.h"
+#include "finecap/surface_gaussians.h"
+
+namespace finecap {
+
+// H_s = sum over the similarity's residuals r of (dr/dk_s)^2 at `k`: the diagonal of the
+// Gauss-Newton approximation of the least-squares cost's Hessian, one entry per parameter.
+Eigen::VectorXd DataCurvature(SimilarityTerm* similarity, const Eigen::VectorXd& k);
+
+// How much the reference colours vary around each surface Gaussian: over the Gaussian and its
+// regulariser neighbours, the median squared distance of their colours from their per-channel
+// median colour (robust, so one odd colour does not make plain cloth look textured). A property
+// of the cloth, not of the cameras: a Gaussian whose normal points straight at a camera moves
+// little in that image as k changes (a small H_s) but still sits on texture.
+Eigen::VectorXd ColorVariation(const SurfaceGaussians& surface, const Regularizer& regularizer);
+
+// How plain the cloth is around each surface Gaussian, in [0, 1]: exp(-V_s / t) with V_s the
+// colour variation and t = confidence_threshold times its median, then a morphological closing
+// (one pass) and opening (confidence_opening passes) over the regulariser neighbourhoods, so that
+// isolated odd Gaussians inside a plain region count as plain and plain patches narrower than the
+// opening count as textured (the regulariser interpolates those well from their surroundings).
+Eigen::VectorXd PlainCloth(const SurfaceGaussians& surface, const Regularizer& regularizer,
+                           const EnergyOptions& options);
+
+// p_s = 2 w_prior u^2 + mu H P_s: the uniform pull and the confidence pull, with u the unit scale
+// of E_reg, mu = confidence_prior, H the median of the positive data curvatures (it gives the
+// pull the data's units) and P_s = `plain_cloth`. Both vectors may be empty when mu is 0.
+Eigen::VectorXd PriorCurvature(const Eigen::VectorXd& data_curvature,
+                               const Eigen::VectorXd& plain_cloth, int num_parameters,
+                               const EnergyOptions& options);
+
+}  // namespace finecap
+
+#endif  // FINECAP_INPUT_PRIOR_H_

@@ -1,0 +1,139 @@
+#include "finecap/input_prior.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace finecap {
+
+Eigen::VectorXd DataCurvature(SimilarityTerm* similarity, const Eigen::VectorXd& k) {
+  similarity->PrepareResiduals(k, true);
+  Eigen::VectorXd curvature = Eigen::VectorXd::Zero(k.size());
+  std::vector<double> residuals, jacobian;
+  const auto& blocks = similarity->residual_blocks();
+  for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+    const int num_parameters = static_cast<int>(blocks[b].parameters.size());
+    residuals.resize(blocks[b].num_residuals);
+    jacobian.resize(blocks[b].num_residuals * num_parameters);
+    similarity->BlockResiduals(b, residuals.data(), jacobian.data());
+    for (int r = 0; r < blocks[b].num_residuals; ++r) {
+      for (int p = 0; p < num_parameters; ++p) {
+        const double derivative = jacobian[r * num_parameters + p];
+        curvature[blocks[b].parameters[p]] += derivative * derivative;
+      }
+    }
+  }
+  return curvature;
+}
+
+namespace {
+
+// Surface Gaussian s and its regulariser neighbours, for each s.
+std::vector<std::vector<int>> Neighbourhoods(int size, const Regularizer& regularizer) {
+  std::vector<std::vector<int>> members(size);
+  for (int s = 0; s < size; ++s) members[s].push_back(s);
+  for (const Regularizer::Pair& pair : regularizer.pairs()) {
+    if (pair.b < 0) continue;
+    members[pair.a].push_back(pair.b);
+    members[pair.b].push_back(pair.a);
+  }
+  return members;
+}
+
+double Median(std::vector<double>* values) {
+  auto middle = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
+}
+
+}  // namespace
+
+namespace {
+
+// The median of the positive entries (0 when there is none): Gaussians no camera sees carry no
+// information about what a typical one is held by.
+double MedianOfPositive(const Eigen::VectorXd& values) {
+  std::vector<double> positive;
+  for (double value : values) {
+    if (value > 0.0) positive.push_back(value);
+  }
+  return positive.empty() ? 0.0 : Median(&positive);
+}
+
+// Each entry replaced by the largest (`dilate`) or smallest of its neighbourhood's.
+Eigen::VectorXd Morph(const Eigen::VectorXd& values, const std::vector<std::vector<int>>& members,
+                      bool dilate) {
+  Eigen::VectorXd result = values;
+  for (int s = 0; s < values.size(); ++s) {
+    for (int j : members[s]) {
+      result[s] = dilate ? std::max(result[s], values[j]) : std::min(result[s], values[j]);
+    }
+  }
+  return result;
+}
+
+// The mean without the largest tenth (at least the largest one).
+double TrimmedMean(std::vector<double>* values) {
+  const size_t kept = values->size() - std::max<size_t>(1, values->size() / 10);
+  if (kept == 0) return 0.0;
+  std::nth_element(values->begin(), values->begin() + kept, values->end());
+  double sum = 0.0;
+  for (size_t i = 0; i < kept; ++i) sum += (*values)[i];
+  return sum / kept;
+}
+
+}  // namespace
+
+Eigen::VectorXd ColorVariation(const SurfaceGaussians& surface, const Regularizer& regularizer) {
+  const std::vector<std::vector<int>> members = Neighbourhoods(surface.size(), regularizer);
+  Eigen::VectorXd variation(surface.size());
+  std::vector<double> values;
+  for (int s = 0; s < surface.size(); ++s) {
+    Eigen::Vector3f center;
+    for (int channel = 0; channel < 3; ++channel) {
+      values.clear();
+      for (int j : members[s]) values.push_back(surface.colors[j][channel]);
+      center[channel] = static_cast<float>(Median(&values));
+    }
+    values.clear();
+    for (int j : members[s]) values.push_back((surface.colors[j] - center).squaredNorm());
+    variation[s] = TrimmedMean(&values);
+  }
+  return variation;
+}
+
+Eigen::VectorXd PlainCloth(const SurfaceGaussians& surface, const Regularizer& regularizer,
+                           const EnergyOptions& options) {
+  const Eigen::VectorXd variation = ColorVariation(surface, regularizer);
+  // When most of the cloth is perfectly plain the median is 0, and so is the threshold: then
+  // exactly the Gaussians without variation are plain.
+  std::vector<double> values(variation.data(), variation.data() + variation.size());
+  const double threshold = values.empty() ? 0.0 : options.confidence_threshold * Median(&values);
+  Eigen::VectorXd plain(variation.size());
+  for (int s = 0; s < variation.size(); ++s) {
+    plain[s] = threshold > 0.0 ? std::exp(-variation[s] / threshold) : variation[s] == 0.0;
+  }
+  const std::vector<std::vector<int>> members = Neighbourhoods(surface.size(), regularizer);
+  // Closing: a lone Gaussian inside plain cloth whose colour came out odd (a blend at a
+  // silhouette in the reference view) would otherwise be left free to chase that colour.
+  plain = Morph(Morph(plain, members, true), members, false);
+  // Opening: a plain patch narrower than the opening is left to the regulariser, which
+  // interpolates it from the texture around it; only wide plain regions are held.
+  for (int i = 0; i < options.confidence_opening; ++i) plain = Morph(plain, members, false);
+  for (int i = 0; i < options.confidence_opening; ++i) plain = Morph(plain, members, true);
+  return plain;
+}
+
+Eigen::VectorXd PriorCurvature(const Eigen::VectorXd& data_curvature,
+                               const Eigen::VectorXd& plain_cloth, int num_parameters,
+                               const EnergyOptions& options) {
+  const double u = options.RegUnitScale();
+  Eigen::VectorXd prior = Eigen::VectorXd::Constant(num_parameters, 2.0 * options.w_prior * u * u);
+  if (options.confidence_prior <= 0.0) return prior;
+  const double typical = MedianOfPositive(data_curvature);
+  if (typical <= 0.0) return prior;
+  prior += options.confidence_prior * typical * plain_cloth;
+  return prior;
+}
+
+}  // namespace finecap

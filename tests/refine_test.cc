@@ -1,0 +1,72 @@
+#include "finecap/refine.h"
+
+#include <gtest/gtest.h>
+
+#include "finecap/capture.h"
+#include "test_util.h"
+#include "tiny_synth.h"
+
+namespace finecap {
+namespace {
+
+FrameInput ReadFrame(Capture* capture, int frame) {
+  FrameInput input;
+  input.coarse = capture->ReadCoarseMesh(frame);
+  input.cameras = capture->cameras();
+  for (int c = 0; c < capture->num_cameras(); ++c) {
+    input.images.push_back(capture->ReadImage(c, frame));
+  }
+  return input;
+}
+
+class RefineFrameTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    directory_ = new std::string(testing_util::MakeTempDir("refine_frame"));
+    GenerateSyntheticCapture(testing_util::TinySynthOptions(), *directory_);
+  }
+  static void TearDownTestSuite() { delete directory_; }
+
+  static std::string* directory_;
+};
+
+std::string* RefineFrameTest::directory_ = nullptr;
+
+// With a schedule, the figures of the frame still refer to the configured energy: it starts
+// where a single-level solve starts and ends at the energy of the k it returns.
+TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
+  Capture capture = Capture::Open(*directory_);
+  RefineOptions options;
+  options.visibility.max_view_angle_deg = 60.0;
+  const FrameInput input = ReadFrame(&capture, 1);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrame(&capture, 0), options);
+
+  const FrameResult single = RefineFrame(model, colors, input, options);
+  options.coarse_to_fine.levels = 2;
+  const FrameResult scheduled = RefineFrame(model, colors, input, options);
+
+  ASSERT_GT(scheduled.num_surface_gaussians, 0);
+  EXPECT_DOUBLE_EQ(scheduled.summary.energy_start, single.summary.energy_start);
+  options.coarse_to_fine.levels = 1;
+  PreparedFrame configured = PrepareFrame(model, colors, input, options);
+  EXPECT_NEAR(configured.energy->Evaluate(scheduled.k_solved, nullptr),
+              scheduled.summary.energy_end, 1e-9 * std::abs(scheduled.summary.energy_end));
+  EXPECT_GT(scheduled.summary.energy_end, scheduled.summary.energy_start);
+  // The coarse level's iterations are counted too: at least one solve on each level.
+  EXPECT_GE(scheduled.summary.iterations, 2);
+}
+
+TEST(CoarseToFineOptionsTest, RefusesLevelsAndScalesOutOfRange) {
+  CoarseToFineOptions options;
+  options.levels = 0;
+  testing_util::ExpectErrorMentions([&] { options.Check(); },
+                                    {"refine.coarse_to_fine.levels", "[1, 5]"});
+  options.levels = 2;
+  options.scale = 1.0;
+  testing_util::ExpectErrorMentions([&] { options.Check(); },
+                                    {"refine.coarse_to_fine.scale", "(1, 4]"});
+}
+
+}  // namespace
+}  // namespace finecap
