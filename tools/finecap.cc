@@ -67,7 +67,7 @@ const std::vector<Subcommand>& Subcommands() {
        {"config", "capture", "out", "frames", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
-       "finecap refine --config configs/demo.yaml [--frames A:B] [--solver "
+       "finecap refine --config configs/demo.yaml [--frames A:B] [--shard I/N] [--solver "
        "ceres|gradient-ascent|lbfgs]"
        " [--capture DIR] [--out DIR]",
        &RunRefine,
