@@ -22,6 +22,14 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
                     "Format of refined meshes (PLY is binary).", {"ply", "obj"});
   schema->AddInt("runtime.threads", &config->runtime.threads,
                  "Worker threads for parallel stages; 0 = all cores.", 0, 1024);
+  schema->AddCustom(
+      "runtime.shard", "string", "I/N, 0 <= I < N",
+      "Refine part I (from 0) of N contiguous near-equal parts of the configured frames.",
+      [config](const YAML::Node& value, const std::string& where) {
+        Require(value.IsScalar(), where, "expected I/N, e.g. 0/4");
+        config->runtime.shard = ParseShard(value.Scalar(), where);
+      },
+      [config] { return config->runtime.shard.ToString(); });
   schema->AddInt("eval.camera", &config->eval.camera,
                  "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
   schema->AddChoice("eval.flow", &config->eval.flow,

@@ -1,5 +1,7 @@
 #include "finecap/frame_stats.h"
 
+#include <sys/resource.h>
+
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -12,6 +14,12 @@ namespace finecap {
 
 using internal::JsonNumber;
 using internal::JsonString;
+
+double PeakResidentMegabytes() {
+  rusage usage = {};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes.
+}
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result) {
@@ -39,6 +47,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.kept_input = result.kept_input;
   stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
   stats.rms_textureless_coarse_mm = stats.rms_textureless_refined_mm = std::nan("");
+  stats.peak_rss_mb = PeakResidentMegabytes();
   return stats;
 }
 
@@ -65,7 +74,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
        << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
-       << ", \"skipped_cameras\": [";
+       << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << ", \"skipped_cameras\": [";
   for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
     json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
   }
@@ -97,7 +106,8 @@ struct StatsFields {
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
-      {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm}};
+      {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm},
+      {"peak_rss_mb", &FrameStats::peak_rss_mb}};
   std::vector<std::pair<const char*, int FrameStats::*>> ints = {
       {"iterations", &FrameStats::iterations},
       {"evaluations", &FrameStats::evaluations},

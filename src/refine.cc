@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 
 #include "finecap/error.h"
 #include "finecap/frame_energy.h"
@@ -110,6 +111,9 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 
 namespace {
 
+// Where the solve of a prepared frame starts: one k per surface Gaussian of `energy`.
+using StartingPointFunction = std::function<Eigen::VectorXd(FrameEnergy* energy)>;
+
 // Level `level` of the coarse-to-fine schedule (0: the configured options): wider surface
 // Gaussians and larger image Gaussians, so that the energy is smoother in k and a fold further
 // than a Gaussian's width from the input surface is still within reach.
@@ -126,8 +130,8 @@ RefineOptions LevelOptions(const RefineOptions& options, int level) {
 // Returns the k to start the configured level from; adds the work done to *totals.
 Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
-                                  const Eigen::VectorXd* warm_start, SolverSummary* totals,
-                                  double* seconds_preparation) {
+                                  const StartingPointFunction& starting_point,
+                                  SolverSummary* totals, double* seconds_preparation) {
   Eigen::VectorXd k;
   for (int level = options.coarse_to_fine.levels - 1; level >= 1; --level) {
     const RefineOptions level_options = LevelOptions(options, level);
@@ -135,7 +139,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
     PreparedFrame frame = PrepareFrame(model, level_colors, input, level_options);
     *seconds_preparation += frame.seconds;
-    if (k.size() == 0) k = StartingPoint(frame.energy.get(), options.sweep, warm_start);
+    if (k.size() == 0) k = starting_point(frame.energy.get());
     const SolverSummary summary = Solve(frame.energy.get(), options.solver, &k);
     totals->iterations += summary.iterations;
     totals->evaluations += summary.evaluations;
@@ -146,21 +150,15 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
   return k;
 }
 
-}  // namespace
-
-Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
-                              const Eigen::VectorXd* warm_start) {
-  if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
-  return SweepInitialization(energy, sweep);
-}
-
-FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
-                        const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start) {
+// RefineFrame, starting each level that does not continue from a coarser one at
+// `starting_point`.
+FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const StartingPointFunction& starting_point) {
   const auto start = std::chrono::steady_clock::now();
   FrameResult result;
   SolverSummary coarse;
-  const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, warm_start,
+  const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
                                                      &coarse, &result.seconds_preparation);
 
   PreparedFrame frame = PrepareFrame(model, colors, input, options);
@@ -171,7 +169,7 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.seconds_preparation += frame.seconds;
 
   // The frame got worse or better against where it started, before any level moved it.
-  const Eigen::VectorXd initial = StartingPoint(&energy, options.sweep, warm_start);
+  const Eigen::VectorXd initial = starting_point(&energy);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = Solve(&energy, options.solver, &k);
   if (coarse_k.size() > 0) {
@@ -200,6 +198,38 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   result.normals = ComputeVertexNormals(result.refined);
   result.seconds_total = SecondsSince(start);
   return result;
+}
+
+}  // namespace
+
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start) {
+  if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
+  return SweepInitialization(energy, sweep);
+}
+
+FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
+                        const FrameInput& input, const RefineOptions& options,
+                        const Eigen::VectorXd* warm_start) {
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    return StartingPoint(energy, options.sweep, warm_start);
+  });
+}
+
+FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
+                            const FrameInput& input, const RefineOptions& options,
+                            const Eigen::VectorXd& start) {
+  Require(start.size() == model.num_fine_vertices(), "refine",
+          "a start of " + std::to_string(start.size()) + " displacements for " +
+              std::to_string(model.num_fine_vertices()) + " fine vertices");
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    Eigen::VectorXd k = SweepInitialization(energy, options.sweep);
+    const std::vector<int>& ids = energy->surface().vertex_ids;
+    for (size_t s = 0; s < ids.size(); ++s) {
+      if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];
+    }
+    return k;
+  });
 }
 
 }  // namespace finecap

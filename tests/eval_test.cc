@@ -116,16 +116,7 @@ TEST(EvaluationTest, HeatMapRunsFromBlueToRedAndGreysUnknowns) {
 }
 
 // 3 cameras of 96 x 96 that see the skirt large, a 16 x 8 skirt, 3 frames.
-SynthOptions TinyCapture() {
-  SynthOptions options = testing_util::TinySynthOptions();
-  options.num_frames = 3;
-  options.skirt.down = 8;
-  options.cameras.count = 3;
-  options.cameras.width = 96;
-  options.cameras.height = 96;
-  options.cameras.focal = 300.0;
-  return options;
-}
+SynthOptions TinyCapture() { return testing_util::TinyRefinableSynthOptions(3); }
 
 Config RunConfig(const std::string& capture, const std::string& out) {
   Config config;

@@ -40,6 +40,19 @@ inline Config TinyRunConfig(const std::string& capture, const std::string& out,
   return config;
 }
 
+// TinySynthOptions with 3 cameras of 96 x 96 that see the skirt large and a 16 x 8 skirt:
+// still tiny, but each frame gives refinement something to do.
+inline SynthOptions TinyRefinableSynthOptions(int num_frames) {
+  SynthOptions options = TinySynthOptions();
+  options.num_frames = num_frames;
+  options.skirt.down = 8;
+  options.cameras.count = 3;
+  options.cameras.width = 96;
+  options.cameras.height = 96;
+  options.cameras.focal = 300.0;
+  return options;
+}
+
 }  // namespace testing_util
 }  // namespace finecap
 

@@ -26,6 +26,9 @@ DEFINE_string(frames, "", "Frames to process, A:B (indices A..B-1); overrides ca
 DEFINE_int32(threads, -1, "Worker threads (0 = all cores); overrides runtime.threads.");
 DEFINE_string(solver, "",
               "Solver: ceres, gradient-ascent (the paper's) or lbfgs; overrides solver.type.");
+DEFINE_string(shard, "",
+              "I/N: refine part I (from 0) of N contiguous near-equal parts of the frames, e.g. "
+              "$SLURM_ARRAY_TASK_ID/4; overrides runtime.shard.");
 DEFINE_bool(config_keys_markdown, false, "Print every config key as a Markdown table and exit.");
 DEFINE_int32(frame, -1, "probe: the frame (index) to probe; -1 = the last.");
 DEFINE_string(set, "",
@@ -64,11 +67,17 @@ const std::vector<Subcommand>& Subcommands() {
        {"config", "capture", "out", "frames", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
-       "finecap refine --config configs/demo.yaml [--frames A:B] [--solver "
+       "finecap refine --config configs/demo.yaml [--frames A:B] [--shard I/N] [--solver "
        "ceres|gradient-ascent|lbfgs]"
        " [--capture DIR] [--out DIR]",
        &RunRefine,
-       {"config", "capture", "out", "frames", "solver", "threads", "set"}},
+       {"config", "capture", "out", "frames", "shard", "solver", "threads", "set"}},
+      {"status",
+       "List the configured frames (of one shard with --shard) that a refine output folder "
+       "lacks; exit code 0 when none, 3 when some are missing.",
+       "finecap status --config FILE [--capture DIR] [--out DIR] [--frames A:B] [--shard I/N]",
+       &RunStatus,
+       {"config", "capture", "out", "frames", "shard", "set"}},
       {"eval",
        "Measure a refined run against the capture's ground truth: pictures, plots, "
        "eval/metrics.json and eval/report.html in the output folder.",
@@ -116,7 +125,7 @@ void PrintMainHelp() {
   }
   text += "\nFlags (a flag overrides its config key):\n";
   for (const char* flag :
-       {"config", "capture", "out", "frames", "solver", "frame", "threads", "set"}) {
+       {"config", "capture", "out", "frames", "shard", "solver", "frame", "threads", "set"}) {
     text += FlagHelp(flag);
   }
   text += "\nConfig keys (YAML sections and keys; type, default, meaning):\n" + ConfigKeysHelp();
@@ -153,6 +162,7 @@ std::vector<ConfigOverride> FlagOverrides() {
   if (!FLAGS_capture.empty()) overrides.push_back({"capture.dir", FLAGS_capture, "--capture"});
   if (!FLAGS_out.empty()) overrides.push_back({"output.dir", FLAGS_out, "--out"});
   if (!FLAGS_frames.empty()) overrides.push_back({"capture.frames", FLAGS_frames, "--frames"});
+  if (!FLAGS_shard.empty()) overrides.push_back({"runtime.shard", FLAGS_shard, "--shard"});
   if (!FLAGS_solver.empty()) {
     // The command line spells it with a hyphen, as the paper's method name reads.
     std::string solver = FLAGS_solver;

@@ -38,6 +38,16 @@ int RunCompare(const Config& config);
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 
+// The exit code of RunStatus when frames are missing (1 stays the code of bad input).
+constexpr int kStatusIncomplete = 3;
+
+// Reports which of the configured frames (of shard runtime.shard) are done in output.dir, a
+// folder of `finecap refine` (mesh, displacement and stats record: see the README): prints
+// "<folder>: D of T frames done (frames A:B)" and a "missing ..." line per run of consecutive
+// missing frames. Returns 0 when every frame is done, kStatusIncomplete otherwise; throws Error
+// naming output.dir when there is no such folder. Writes nothing.
+int RunStatus(const Config& config);
+
 }  // namespace finecap
 
 #endif  // FINECAP_COMMANDS_H_

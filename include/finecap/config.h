@@ -12,6 +12,7 @@
 #include "finecap/config_schema.h"
 #include "finecap/frame_range.h"
 #include "finecap/refine.h"
+#include "finecap/shard.h"
 #include "finecap/synth.h"
 
 namespace finecap {
@@ -41,6 +42,9 @@ struct OutputConfig {
 struct RuntimeConfig {
   // Worker threads for parallel stages; 0 = all cores.
   int threads = 0;
+  // Which part of the configured frames this process refines ("I/N", 0-based; see shard.h), so
+  // that N processes can share one output folder. Default 0/1: all of them.
+  Shard shard;
 };
 
 // How `finecap eval` evaluates a refined run.

@@ -41,7 +41,13 @@ struct FrameStats {
   // Cameras left out of this frame because their image could not be read
   // (capture.skip_unreadable_cameras); empty when every camera was used.
   std::vector<std::string> skipped_cameras;
+  // The process's peak resident memory when the frame was done (getrusage's ru_maxrss), MB of
+  // 2^20 bytes. Over a long run it should stay flat: nothing grows with the frames.
+  double peak_rss_mb = 0.0;
 };
+
+// The peak resident memory of this process so far, MB of 2^20 bytes (getrusage's ru_maxrss).
+double PeakResidentMegabytes();
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result);

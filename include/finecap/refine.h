@@ -172,6 +172,16 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
                         const FrameInput& input, const RefineOptions& options,
                         const Eigen::VectorXd* warm_start = nullptr);
 
+// RefineFrame, starting from `start`: one displacement per fine vertex, metres, as solved
+// (before bias compensation); NaN where there is none, and those vertices start where RefineFrame
+// would start them (at zero, or where the plane sweep puts them). This is how a frame is seeded
+// from another frame's saved result: a fine vertex keeps its id over the sequence, while the
+// surface Gaussians of two frames may differ. Throws Error when `start` has not one entry per
+// fine vertex.
+FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
+                            const FrameInput& input, const RefineOptions& options,
+                            const Eigen::VectorXd& start);
+
 }  // namespace finecap
 
 #endif  // FINECAP_REFINE_H_

@@ -8,6 +8,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "commands/run_folder.h"
 #include "finecap/error.h"
 #include "finecap/ground_truth.h"
 #include "io_util.h"
@@ -41,7 +42,8 @@ std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
           "the output folder may not be the capture folder or lie inside it");
   std::error_code error;
   fs::create_directories(out, error);
-  Require(!error && fs::is_directory(out), config.output.dir,
+  // A concurrent shard may create it at the same moment: what matters is that it exists.
+  Require(fs::is_directory(out), config.output.dir,
           "cannot create the output folder: " + error.message());
   return out.string();
 }
@@ -103,9 +105,9 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
               capture->directory());
   const FrameInput reference = ReadFrameInput(capture, config.reference_frame,
                                               config.capture.skip_unreadable_cameras, nullptr);
-  const ReferenceColors colors = ComputeSequenceColors(model, reference, config.refine);
-  WriteReferenceColors(path, colors);
-  return colors;
+  WriteReferenceColors(path, ComputeSequenceColors(model, reference, config.refine));
+  // As saved: every run and shard on this folder then starts from the very same colours.
+  return ReadReferenceColors(path, model.num_fine_vertices());
 }
 
 Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
@@ -122,16 +124,13 @@ std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture&
   std::vector<RefinedFrame> frames;
   for (int frame = range.begin; frame < range.end; ++frame) {
     const std::string& name = capture.frame_name(frame);
-    RefinedFrame refined{frame, name, out + "/meshes/" + name + "." + config.output.mesh_format,
-                         out + "/k/" + name + ".txt"};
-    if (fs::is_regular_file(refined.mesh) && fs::is_regular_file(refined.displacement)) {
-      frames.push_back(refined);
-    }
+    const FrameFiles files = FrameFilesIn(out, name, config.output.mesh_format);
+    if (FrameDone(files)) frames.push_back({frame, name, files.mesh, files.displacement});
   }
   Require(!frames.empty(), out,
           "holds no refined run of the configured frames of " + capture.directory() +
               " (no meshes/<frame>." + config.output.mesh_format +
-              " with k/<frame>.txt): run finecap refine first");
+              " with k/<frame>.txt and frames/<frame>.json): run finecap refine first");
   return frames;
 }
 

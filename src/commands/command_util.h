@@ -37,7 +37,8 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
                           std::vector<std::string>* skipped);
 
 // The reference colours saved in `path`, or, when there is no such file, those of the
-// configured reference frame, computed and saved there.
+// configured reference frame, computed, saved there and read back (so a run uses exactly what a
+// later resumed run or shard will read).
 ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
                                              Capture* capture, const std::string& path);
 
@@ -52,7 +53,7 @@ struct RefinedFrame {
   std::string name, mesh, displacement;
 };
 
-// The configured frames whose refined mesh and displacement exist in `out`, in frame order;
+// The configured frames done in `out` (mesh, displacement and stats record), in frame order;
 // an Error naming `out` when there is none.
 std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
                                             const std::string& out);

@@ -1,10 +1,10 @@
 // finecap refine: every configured frame of a capture, refined and written to output.dir.
-#include <filesystem>
-#include <fstream>
+#include <charconv>
 #include <iostream>
 #include <sstream>
 
 #include "commands/command_util.h"
+#include "commands/run_folder.h"
 #include "finecap/atomic_file.h"
 #include "finecap/commands.h"
 #include "finecap/error.h"
@@ -12,41 +12,40 @@
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
 #include "finecap/scene_scale.h"
+#include "finecap/shard.h"
 #include "finecap/solver_trace.h"
 
 namespace finecap {
 namespace {
 
-namespace fs = std::filesystem;
-
-// Where the results of one frame go.
-struct FramePaths {
-  std::string mesh, displacement, stats, trace;
-};
-
-FramePaths OutputPaths(const std::string& out, const std::string& frame, const Config& config) {
-  return {out + "/meshes/" + frame + "." + config.output.mesh_format, out + "/k/" + frame + ".txt",
-          out + "/frames/" + frame + ".json", out + "/traces/" + frame + ".csv"};
-}
-
+// One number per line, written in the shortest form that reads back to the same double, so that
+// a frame seeded from this file (a resumed run's warm start) starts exactly where a run that never
+// stopped would.
 void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k) {
-  std::ostringstream text;
-  text << "# displacement along the normal of each vertex of the refined mesh, metres; nan where "
-          "not refined\n";
-  text.precision(9);
-  for (int v = 0; v < k.size(); ++v) text << k[v] << "\n";
-  WriteTextFileAtomically(path, text.str());
+  std::string text =
+      "# displacement along the normal of each vertex of the refined mesh, metres; nan where "
+      "not refined\n";
+  char number[64];
+  for (int v = 0; v < k.size(); ++v) {
+    const auto written = std::to_chars(number, number + sizeof(number), k[v]);
+    text.append(number, written.ptr).push_back('\n');
+  }
+  WriteTextFileAtomically(path, text);
 }
 
-// Rewrites stats.jsonl from the per-frame records of every frame done so far, in frame order.
-void WriteStatsLines(const std::string& out, const Capture& capture, const Config& config) {
-  std::string lines;
-  for (const std::string& frame : capture.frame_names()) {
-    std::ifstream record(OutputPaths(out, frame, config).stats);
-    std::string line;
-    if (record && std::getline(record, line)) lines += line + "\n";
-  }
-  WriteTextFileAtomically(out + "/stats.jsonl", lines);
+// With refine.warm_start: the saved displacement of the frame before `frame`, as solved (bias
+// compensation taken off), which seeds `frame`; empty when that frame is not done in `out` (the
+// frame then starts from zero). Always from the saved file, so that a resumed run or a shard
+// seeds its first frame exactly as a run that never stopped seeds every frame.
+Eigen::VectorXd WarmStart(const std::string& out, const Capture& capture, int frame,
+                          const Config& config, const SequenceModel& model) {
+  if (!config.refine.warm_start || frame == 0) return {};
+  const internal::FrameFiles previous =
+      internal::FrameFilesIn(out, capture.frame_name(frame - 1), config.output.mesh_format);
+  if (!internal::FrameDone(previous)) return {};
+  const double bias = config.refine.bias_compensation ? config.refine.sigma_hat : 0.0;
+  return internal::ReadDisplacement(previous.displacement, model.num_fine_vertices()).array() -
+         bias;
 }
 
 // The refined vertices outside and inside the capture's textureless region.
@@ -99,12 +98,20 @@ void PrintProblemSize(const Capture& capture, const SequenceModel& model, int fr
 
 int RunRefine(const Config& config) {
   Capture capture = internal::OpenConfiguredCapture(config);
-  const FrameRange frames = internal::ConfiguredFrames(config, capture);
+  const FrameRange frames =
+      ShardOf(internal::ConfiguredFrames(config, capture), config.runtime.shard);
   RequirePlausibleSceneScale(capture.ReadCoarseMesh(0), config.refine.sigma_hat,
                              capture.mesh_path(0));
   const std::string out = internal::PrepareOutputFolder(config, capture);
-  for (const char* folder : {"meshes", "k", "frames", "traces"})
-    fs::create_directories(out + "/" + folder);
+  const int stale = internal::PrepareRunSubfolders(out);
+  if (stale > 0) std::cerr << "finecap refine: removed " << stale << " files a killed run left\n";
+  const internal::StatsLog stats_log(out, capture.frame_names(), config.output.mesh_format);
+  stats_log.Rebuild();
+  if (frames.size() == 0) {
+    std::cout << "Shard " << config.runtime.shard.ToString() << " holds none of the "
+              << internal::ConfiguredFrames(config, capture).size() << " configured frames\n";
+    return 0;
+  }
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.mesh_path(0));
@@ -114,13 +121,12 @@ int RunRefine(const Config& config) {
   PrintProblemSize(capture, model, frames.size());
 
   internal::Progress progress(frames.size());
-  Eigen::VectorXd previous_k;
   double sum_coarse2 = 0.0, sum_refined2 = 0.0;
   int measured = 0;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
     const std::string& name = capture.frame_name(frame);
-    const FramePaths paths = OutputPaths(out, name, config);
-    if (fs::exists(paths.mesh) && fs::exists(paths.stats)) {
+    const internal::FrameFiles files = internal::FrameFilesIn(out, name, config.output.mesh_format);
+    if (internal::FrameDone(files)) {
       progress.FrameDone(name, true, "");
       continue;
     }
@@ -128,10 +134,10 @@ int RunRefine(const Config& config) {
     std::vector<std::string> skipped;
     const FrameInput input =
         internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
-    const bool warm = config.refine.warm_start && previous_k.size() > 0;
-    FrameResult result =
-        RefineFrame(model, colors, input, config.refine, warm ? &previous_k : nullptr);
-    previous_k = result.k_solved;
+    const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
+    FrameResult result = warm_start.size() > 0
+                             ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
+                             : RefineFrame(model, colors, input, config.refine);
     if (result.num_surface_gaussians == 0) {
       std::cerr << "finecap refine: warning: frame " << name
                 << ": no camera sees any vertex to refine (the mesh is behind every camera or "
@@ -142,13 +148,15 @@ int RunRefine(const Config& config) {
     stats.skipped_cameras = skipped;
     AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
-    WriteMesh(paths.mesh, result.refined, {result.normals, {}, quality},
+    WriteMesh(files.mesh, result.refined, {result.normals, {}, quality},
               config.output.mesh_format == "obj" ? MeshFormat::kObj : MeshFormat::kPly);
-    WriteDisplacement(paths.displacement, result.k);
-    WriteTextFileAtomically(paths.trace, SolverTraceCsv(result.summary.trace));
+    WriteDisplacement(files.displacement, result.k);
+    WriteTextFileAtomically(files.trace, SolverTraceCsv(result.summary.trace));
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    WriteTextFileAtomically(paths.stats, ToJson(stats) + "\n");
-    WriteStatsLines(out, capture, config);
+    // Last: the record marks the frame done.
+    const std::string record = ToJson(stats);
+    WriteTextFileAtomically(files.stats, record + "\n");
+    stats_log.Append(record);
 
     std::ostringstream detail;
     detail.precision(3);
@@ -162,6 +170,7 @@ int RunRefine(const Config& config) {
     }
     progress.FrameDone(name, false, detail.str());
   }
+  stats_log.Rebuild();
   std::cout << "Refined meshes: " << out << "/meshes/, displacements: " << out
             << "/k/, statistics: " << out << "/stats.jsonl\n";
   if (measured > 0) {
