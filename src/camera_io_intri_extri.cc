@@ -11,8 +11,18 @@
 namespace finecap {
 namespace {
 
+// YAML and XML are text: a NUL byte means a damaged or binary file. OpenCV 4.6's YAML parser reads
+// NUL as the end of its buffer and can loop forever on such a file, so it never sees one.
+void RequireNoNulByte(const std::string& path) {
+  const std::string bytes = internal::ReadWholeFile(path);
+  const size_t nul = bytes.find('\0');
+  Require(
+      nul == std::string::npos, path,
+      "contains a NUL byte at offset " + std::to_string(nul) + ": not a text OpenCV YAML/XML file");
+}
+
 cv::FileStorage OpenStorage(const std::string& path) {
-  internal::RequireFile(path);
+  RequireNoNulByte(path);
   try {
     cv::FileStorage storage(path, cv::FileStorage::READ);
     Require(storage.isOpened(), path, "cannot open as an OpenCV YAML/XML file");

@@ -5,8 +5,11 @@
 
 #include <memory>
 #include <random>
+#include <string>
+#include <tuple>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
 #include "finecap/frame_energy.h"
@@ -108,6 +111,20 @@ inline EnergyScene MakeEnergyScene(const std::vector<double>& tilts, int per_sur
     scene.cameras.push_back(std::move(input));
   }
   return scene;
+}
+
+// A form of the energy for parameterised tests: (similarity, overlap).
+using EnergyForm = std::tuple<std::string, std::string>;
+
+// Each similarity with the printed and the exact overlap.
+inline auto AllEnergyForms() {
+  return ::testing::Combine(::testing::Values("paper", "surface_color"),
+                            ::testing::Values("printed", "exact"));
+}
+
+// "paper_exact" and so on: the test names of AllEnergyForms().
+inline std::string EnergyFormName(const ::testing::TestParamInfo<EnergyForm>& info) {
+  return std::get<0>(info.param) + "_" + std::get<1>(info.param);
 }
 
 // Displacements uniform in [-amplitude, amplitude], metres.

@@ -19,8 +19,7 @@ EnergyOptions Options(const std::string& similarity, const std::string& overlap)
   return options;
 }
 
-class EnergyDerivativeTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {
-};
+class EnergyDerivativeTest : public ::testing::TestWithParam<EnergyForm> {};
 
 // dE/dk of the full energy (similarity and regulariser) against central differences, for
 // cameras from straight on to grazing (80 degrees).
@@ -47,12 +46,7 @@ TEST_P(EnergyDerivativeTest, GradientMatchesCentralDifferences) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllForms, EnergyDerivativeTest,
-                         ::testing::Combine(::testing::Values("paper", "surface_color"),
-                                            ::testing::Values("printed", "exact")),
-                         [](const auto& info) {
-                           return std::get<0>(info.param) + "_" + std::get<1>(info.param);
-                         });
+INSTANTIATE_TEST_SUITE_P(AllForms, EnergyDerivativeTest, AllEnergyForms(), EnergyFormName);
 
 // Every least-squares residual's Jacobian against central differences of the residuals.
 TEST_P(EnergyDerivativeTest, ResidualJacobiansMatchCentralDifferences) {

@@ -50,6 +50,20 @@ TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
                       {dir + "/intri.yml", "K_01", "3x300000", "at most 16"});
 }
 
+// OpenCV 4.6's YAML parser looped forever on this intri.yml: it reads the NUL byte as the end of
+// its buffer. Text files with a NUL byte are refused before OpenCV sees them.
+TEST(FuzzRegression, IntriYmlWithANulByteThatMadeOpenCvLoopForever) {
+  const std::string dir = MakeTempDir("fuzz_intri_nul");
+  std::string bytes = "%YAML:1.\xd8";  // a literal of its own: "\xd8AML" would be one escape
+  bytes += "AML:1.$";
+  bytes += '\0';
+  bytes += "\n\n -\"\"\n_0\n-";
+  WriteText(dir + "/intri.yml", bytes);
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {dir + "/intri.yml", "NUL byte at offset 16"});
+}
+
 // YAML allows a list or a mapping as a key; yaml-cpp's conversion of it to a string threw
 // YAML::TypedBadConversion past our parsers.
 TEST(FuzzRegression, YamlKeysThatAreListsOrMappings) {

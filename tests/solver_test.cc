@@ -33,7 +33,7 @@ bool CheckGradient(const ceres::CostFunction& cost, const std::vector<double>& v
   return ok;
 }
 
-class CeresCostTest : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+class CeresCostTest : public ::testing::TestWithParam<EnergyForm> {};
 
 // Every kind of least-squares residual, checked by ceres::GradientChecker against numeric
 // differences, including cameras at 75 degrees (near grazing).
@@ -62,12 +62,7 @@ TEST_P(CeresCostTest, SimilarityBlocksPassTheGradientChecker) {
   EXPECT_EQ(failed, 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllForms, CeresCostTest,
-                         ::testing::Combine(::testing::Values("paper", "surface_color"),
-                                            ::testing::Values("printed", "exact")),
-                         [](const auto& info) {
-                           return std::get<0>(info.param) + "_" + std::get<1>(info.param);
-                         });
+INSTANTIATE_TEST_SUITE_P(AllForms, CeresCostTest, AllEnergyForms(), EnergyFormName);
 
 TEST(CeresCostTest, RegularizerPairsPassTheGradientChecker) {
   std::string error;
