@@ -8,7 +8,10 @@ build_dir=build
 extra=()
 if [ "${1:-}" = "--sanitize" ]; then
   build_dir=build-sanitize
-  extra=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DFINECAP_SANITIZE=ON -DFINECAP_BUILD_BENCHMARKS=OFF)
+  # -O1 with line tables only: stack traces keep their file:line, and the build takes ~40 % less
+  # time than -O2 -g, which is most of CI's time.
+  extra=(-DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+    -DFINECAP_SANITIZE=ON -DFINECAP_BUILD_BENCHMARKS=OFF)
 fi
 cmake -S . -B "$build_dir" -G Ninja "${extra[@]}" >/dev/null
 cmake --build "$build_dir" -j "$(nproc)"
