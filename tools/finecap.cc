@@ -16,6 +16,7 @@
 #include "finecap/commands.h"
 #include "finecap/config.h"
 #include "finecap/error.h"
+#include "finecap/threads.h"
 
 DECLARE_bool(help);
 
@@ -209,6 +210,7 @@ int Main(int argc, char** argv) {
     return 2;
   }
   const Config config = LoadConfig(FLAGS_config, FlagOverrides());
+  SetWorkerThreads(config.runtime.threads);
   return subcommand->run(config);
 }
 

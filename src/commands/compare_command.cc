@@ -13,6 +13,7 @@
 #include "finecap/html_report.h"
 #include "finecap/plot.h"
 #include "finecap/solver_trace.h"
+#include "finecap/threads.h"
 #include "io_util.h"
 
 namespace finecap {
@@ -178,9 +179,11 @@ int RunCompare(const Config& config) {
     std::cerr << "finecap compare: variant " << i + 1 << "/" << variants.size() << ", "
               << SettingsText(variants[i].spec) << "\n";
     ShareReferenceColors(variants, i);
+    SetWorkerThreads(variants[i].config.runtime.threads);  // a variant may set runtime.threads
     RunRefine(variants[i].config);
     rows.push_back(MeasureVariant(variants[i], frames, &capture));
   }
+  SetWorkerThreads(config.runtime.threads);
   const int reference = ReferenceVariant(rows, config.compare.reference);
   SetTimeRatios(reference, &rows);
 
