@@ -51,8 +51,47 @@ Eigen::Vector2d Camera::Project(const Eigen::Vector3d& world,
   return pixel;
 }
 
+namespace {
+
+// Length of the UTF-8 sequence that starts with `lead`, 0 when `lead` cannot start one.
+int Utf8SequenceLength(unsigned char lead) {
+  if (lead < 0x80) return 1;
+  if (lead >= 0xc2 && lead <= 0xdf) return 2;
+  if (lead >= 0xe0 && lead <= 0xef) return 3;
+  if (lead >= 0xf0 && lead <= 0xf4) return 4;
+  return 0;
+}
+
+// A camera's name names its image folder and is written back into YAML files: printable UTF-8
+// (no control characters, which YAML escapes and a file system may refuse), no path separator.
+bool IsUsableCameraName(const std::string& name) {
+  if (name.empty() || name == "." || name == "..") return false;
+  for (size_t i = 0; i < name.size();) {
+    const unsigned char lead = static_cast<unsigned char>(name[i]);
+    const int length = Utf8SequenceLength(lead);
+    if (length == 0 || i + length > name.size()) return false;
+    if (length == 1 && (lead < 0x20 || lead == 0x7f || lead == '/' || lead == '\\')) return false;
+    for (int j = 1; j < length; ++j) {
+      if ((static_cast<unsigned char>(name[i + j]) & 0xc0) != 0x80) return false;
+    }
+    // No overlong forms, surrogates or code points above U+10FFFF.
+    const unsigned char second = length > 1 ? static_cast<unsigned char>(name[i + 1]) : 0x80;
+    if ((lead == 0xe0 && second < 0xa0) || (lead == 0xed && second > 0x9f) ||
+        (lead == 0xf0 && second < 0x90) || (lead == 0xf4 && second > 0x8f)) {
+      return false;
+    }
+    i += length;
+  }
+  return true;
+}
+
+}  // namespace
+
 void Camera::Validate(const std::string& where) const {
   const std::string at = where + " (camera '" + name + "')";
+  Require(IsUsableCameraName(name), at,
+          "a camera name must be printable UTF-8 text without '/' or '\\' (it names the "
+          "camera's image folder)");
   Require(width > 0 && height > 0, at, "image size must be positive");
   Require(K.allFinite() && R.allFinite() && t.allFinite(), at, "non-finite value in K, R or t");
   for (double coefficient : distortion) {

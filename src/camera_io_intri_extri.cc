@@ -1,8 +1,13 @@
-// The intri.yml / extri.yml pair of ZJU-MoCap and EasyMocap, read with cv::FileStorage.
-#include <Eigen/Core>
-#include <opencv2/calib3d.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/core/eigen.hpp>
+// The intri.yml / extri.yml pair of ZJU-MoCap and EasyMocap: files that OpenCV's FileStorage
+// writes, read here with yaml-cpp. OpenCV 4.6's own YAML parser never returns on some damaged
+// files (fuzzing found two, one of 20 plain ASCII bytes), and a parser that can hang cannot be
+// guarded from outside; yaml-cpp, which reads every other YAML file of finecap, can be.
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+#include <Eigen/Geometry>
 
 #include "finecap/camera_io.h"
 #include "finecap/error.h"
@@ -11,140 +16,160 @@
 namespace finecap {
 namespace {
 
-// YAML and XML are text: a NUL byte means a damaged or binary file. OpenCV 4.6's YAML parser reads
-// NUL as the end of its buffer and can loop forever on such a file, so it never sees one.
-void RequireNoNulByte(const std::string& path) {
-  const std::string bytes = internal::ReadWholeFile(path);
-  const size_t nul = bytes.find('\0');
-  Require(
-      nul == std::string::npos, path,
-      "contains a NUL byte at offset " + std::to_string(nul) + ": not a text OpenCV YAML/XML file");
+// A matrix of doubles as OpenCV writes it: a map of rows, cols, dt and data (row-major).
+struct OpenCvMatrix {
+  int rows = 0;
+  int cols = 0;
+  std::vector<double> data;
+
+  bool empty() const { return data.empty(); }
+};
+
+// YAML and XML are text: a NUL byte means a damaged or binary file.
+void RequireNoNulByte(const std::string& path, const std::string& text) {
+  const size_t nul = text.find('\0');
+  Require(nul == std::string::npos, path,
+          "contains a NUL byte at offset " + std::to_string(nul) + ": not a text YAML file");
 }
 
-cv::FileStorage OpenStorage(const std::string& path) {
-  RequireNoNulByte(path);
+// OpenCV starts its files with "%YAML:1.0", which is not a YAML directive ("%YAML 1.0"): that line
+// is blanked (kept as an empty line, so that line numbers stay right) before yaml-cpp reads the
+// rest.
+YAML::Node LoadOpenCvYaml(const std::string& path) {
+  std::string text = internal::ReadWholeFile(path);
+  RequireNoNulByte(path, text);
+  if (text.rfind("%YAML:", 0) == 0) text.erase(0, text.find('\n'));
+  YAML::Node root;
   try {
-    cv::FileStorage storage(path, cv::FileStorage::READ);
-    Require(storage.isOpened(), path, "cannot open as an OpenCV YAML/XML file");
-    // Looking a key up in anything but a mapping is an assertion failure in OpenCV.
-    Require(storage.root().isMap(), path, "the top level must be a mapping of keys");
-    return storage;
-  } catch (const Error&) {
-    throw;
-  } catch (const cv::Exception& error) {
-    throw Error(path, "malformed OpenCV YAML/XML file: " + error.msg);
-  } catch (const std::exception& error) {
-    // OpenCV's parser lets library exceptions through on some damaged files (std::length_error
-    // from a string it sizes from the file).
-    throw Error(path, std::string("malformed OpenCV YAML/XML file: ") + error.what());
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& error) {
+    throw Error(path, "malformed OpenCV YAML file at line " + std::to_string(error.mark.line + 1) +
+                          ": " + error.msg);
+  } catch (const YAML::Exception& error) {
+    throw Error(path, std::string("malformed OpenCV YAML file: ") + error.what());
   }
+  Require(root.IsMap(), path, "the top level must be a mapping of keys");
+  return root;
 }
 
 std::string KeyLocation(const std::string& path, const std::string& key) {
   return path + " (key '" + key + "')";
 }
 
-// OpenCV allocates the size a matrix node declares before it reads the data, so a damaged `rows`
-// or `cols` could ask for gigabytes: the declared size is checked first. A rig's matrices are at
-// most 3x3 or 1x5.
-void RequireSmallMatrixNode(const cv::FileNode& node, const std::string& where) {
-  constexpr int kMaxSide = 16;
-  Require(node.isMap(), where, "is not an OpenCV matrix (a map of rows, cols, dt, data)");
-  const cv::FileNode rows = node["rows"];
-  const cv::FileNode cols = node["cols"];
-  Require(rows.isInt() && cols.isInt(), where, "the matrix's rows and cols must be integers");
-  const int num_rows = static_cast<int>(rows);
-  const int num_cols = static_cast<int>(cols);
-  Require(num_rows >= 0 && num_rows <= kMaxSide && num_cols >= 0 && num_cols <= kMaxSide, where,
-          "declares a " + std::to_string(num_rows) + "x" + std::to_string(num_cols) +
-              " matrix; a camera's matrices have at most " + std::to_string(kMaxSide) +
-              " rows and columns");
+int ReadInt(const YAML::Node& node, const std::string& where, const std::string& what) {
+  int value = 0;
+  Require(node.IsScalar() && internal::ParseInt(node.Scalar(), &value), where,
+          what + " must be an integer");
+  return value;
 }
 
-// The matrix stored under `key`, as doubles; empty when the key is absent.
-cv::Mat ReadMatrix(const cv::FileStorage& storage, const std::string& key,
-                   const std::string& path) {
-  const cv::FileNode node = storage[key];
-  if (node.empty() || node.isNone()) return cv::Mat();
-  RequireSmallMatrixNode(node, KeyLocation(path, key));
-  cv::Mat matrix;
-  try {
-    node >> matrix;
-  } catch (const cv::Exception& error) {
-    throw Error(KeyLocation(path, key), "is not an OpenCV matrix: " + error.msg);
+// The matrix stored under `key`; empty when the key is absent. The declared size is checked
+// before anything is read: a rig's matrices are at most 3x3 or 1x5, and a damaged `rows` or
+// `cols` must not ask for gigabytes.
+OpenCvMatrix ReadMatrix(const YAML::Node& root, const std::string& key, const std::string& path) {
+  constexpr int kMaxSide = 16;
+  const YAML::Node node = root[key];
+  OpenCvMatrix matrix;
+  if (!node || node.IsNull()) return matrix;
+  const std::string where = KeyLocation(path, key);
+  Require(node.IsMap(), where, "is not an OpenCV matrix (a map of rows, cols, dt, data)");
+  matrix.rows = ReadInt(node["rows"], where, "the matrix's rows");
+  matrix.cols = ReadInt(node["cols"], where, "the matrix's cols");
+  Require(
+      matrix.rows >= 1 && matrix.rows <= kMaxSide && matrix.cols >= 1 && matrix.cols <= kMaxSide,
+      where,
+      "declares a " + std::to_string(matrix.rows) + "x" + std::to_string(matrix.cols) +
+          " matrix; a camera's matrices have at least 1 and at most " + std::to_string(kMaxSide) +
+          " rows and columns");
+  const YAML::Node data = node["data"];
+  const size_t count = static_cast<size_t>(matrix.rows) * matrix.cols;
+  Require(data.IsSequence() && data.size() == count, where,
+          "data must be a list of " + std::to_string(count) + " numbers (rows x cols)");
+  for (const YAML::Node& element : data) {
+    double value = 0.0;
+    Require(element.IsScalar() && internal::ParseDouble(element.Scalar(), &value), where,
+            "data must be numbers");
+    matrix.data.push_back(value);
   }
-  Require(!matrix.empty() && matrix.channels() == 1, KeyLocation(path, key),
-          "is not a one-channel matrix");
-  matrix.convertTo(matrix, CV_64F);
   return matrix;
 }
 
-cv::Mat RequireMatrix(const cv::FileStorage& storage, const std::string& key, int rows, int cols,
-                      const std::string& path) {
-  const cv::Mat matrix = ReadMatrix(storage, key, path);
+// The matrix under `key`, which must hold rows x cols numbers (a vector may be stored either
+// way round), row-major.
+std::vector<double> RequireMatrix(const YAML::Node& root, const std::string& key, int rows,
+                                  int cols, const std::string& path) {
+  const OpenCvMatrix matrix = ReadMatrix(root, key, path);
   Require(!matrix.empty(), KeyLocation(path, key), "missing key");
   Require(matrix.rows * matrix.cols == rows * cols && (matrix.rows == rows || matrix.rows == cols),
           KeyLocation(path, key),
           "must be " + std::to_string(rows) + "x" + std::to_string(cols) + ", is " +
               std::to_string(matrix.rows) + "x" + std::to_string(matrix.cols));
-  return matrix.reshape(1, rows);
+  return matrix.data;
 }
 
-std::vector<std::string> ReadNames(const cv::FileStorage& storage, const std::string& path) {
-  const cv::FileNode node = storage["names"];
-  Require(node.isSeq() && node.size() > 0, KeyLocation(path, "names"),
+Eigen::Matrix3d RowMajor3x3(const std::vector<double>& values) {
+  Eigen::Matrix3d matrix;
+  for (int i = 0; i < 9; ++i) matrix(i / 3, i % 3) = values[i];
+  return matrix;
+}
+
+std::vector<std::string> ReadNames(const YAML::Node& root, const std::string& path) {
+  const YAML::Node node = root["names"];
+  Require(node.IsSequence() && node.size() > 0, KeyLocation(path, "names"),
           "missing or not a non-empty list of camera names");
   std::vector<std::string> names;
-  for (const cv::FileNode& element : node) {
-    if (element.isInt()) {
-      names.push_back(std::to_string(static_cast<int>(element)));
-    } else {
-      Require(element.isString(), KeyLocation(path, "names"), "names must be strings");
-      names.push_back(element.string());
-    }
+  for (const YAML::Node& element : node) {
+    Require(element.IsScalar(), KeyLocation(path, "names"), "names must be strings");
+    names.push_back(element.Scalar());
   }
   return names;
 }
 
-void ReadIntrinsics(const cv::FileStorage& intri, const std::string& path, Camera* camera) {
+void ReadIntrinsics(const YAML::Node& intri, const std::string& path, Camera* camera) {
   const std::string& name = camera->name;
-  cv::cv2eigen(RequireMatrix(intri, "K_" + name, 3, 3, path), camera->K);
-  const cv::Mat dist = ReadMatrix(intri, "dist_" + name, path);
+  camera->K = RowMajor3x3(RequireMatrix(intri, "K_" + name, 3, 3, path));
+  const OpenCvMatrix dist = ReadMatrix(intri, "dist_" + name, path);
   if (!dist.empty()) {
-    Require((dist.rows == 1 || dist.cols == 1) && dist.total() <= 5,
+    Require((dist.rows == 1 || dist.cols == 1) && dist.data.size() <= 5,
             KeyLocation(path, "dist_" + name), "must be a vector of at most 5 coefficients");
-    for (size_t i = 0; i < dist.total(); ++i) camera->distortion[i] = dist.at<double>(i);
+    std::copy(dist.data.begin(), dist.data.end(), camera->distortion.begin());
   }
-  const cv::FileNode height = intri["H_" + name];
-  const cv::FileNode width = intri["W_" + name];
-  if (!height.empty() || !width.empty()) {
-    Require(height.isInt() && width.isInt(), KeyLocation(path, "H_" + name),
-            "H_" + name + " and W_" + name + " must both be integers");
-    camera->height = static_cast<int>(height);
-    camera->width = static_cast<int>(width);
+  const YAML::Node height = intri["H_" + name];
+  const YAML::Node width = intri["W_" + name];
+  if (height || width) {
+    const std::string where = KeyLocation(path, "H_" + name);
+    const std::string what = "H_" + name + " and W_" + name;
+    camera->height = ReadInt(height, where, what);
+    camera->width = ReadInt(width, where, what);
   }
 }
 
-void ReadExtrinsics(const cv::FileStorage& extri, const std::string& path, Camera* camera) {
+// R_<cam> is a Rodrigues vector: its direction the axis, its length the angle.
+Eigen::Matrix3d RotationOfRodrigues(const std::vector<double>& r) {
+  const Eigen::Vector3d vector(r[0], r[1], r[2]);
+  const double angle = vector.norm();
+  if (angle < 1e-300) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, vector / angle).toRotationMatrix();
+}
+
+void ReadExtrinsics(const YAML::Node& extri, const std::string& path, Camera* camera) {
   const std::string& name = camera->name;
-  const cv::Mat rotation_matrix = ReadMatrix(extri, "Rot_" + name, path);
-  if (!rotation_matrix.empty()) {
-    cv::cv2eigen(RequireMatrix(extri, "Rot_" + name, 3, 3, path), camera->R);
+  if (!ReadMatrix(extri, "Rot_" + name, path).empty()) {
+    camera->R = RowMajor3x3(RequireMatrix(extri, "Rot_" + name, 3, 3, path));
   } else {
     Require(!ReadMatrix(extri, "R_" + name, path).empty(), KeyLocation(path, "R_" + name),
             "missing key (neither R_" + name + " nor Rot_" + name + " is given)");
-    cv::Mat rotation;
-    cv::Rodrigues(RequireMatrix(extri, "R_" + name, 3, 1, path), rotation);
-    cv::cv2eigen(rotation, camera->R);
+    camera->R = RotationOfRodrigues(RequireMatrix(extri, "R_" + name, 3, 1, path));
   }
-  cv::cv2eigen(RequireMatrix(extri, "T_" + name, 3, 1, path), camera->t);
+  const std::vector<double> t = RequireMatrix(extri, "T_" + name, 3, 1, path);
+  camera->t = Eigen::Vector3d(t[0], t[1], t[2]);
 }
 
 }  // namespace
 
 std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::string& extri_path) {
-  const cv::FileStorage intri = OpenStorage(intri_path);
-  const cv::FileStorage extri = OpenStorage(extri_path);
+  const YAML::Node intri = LoadOpenCvYaml(intri_path);
+  const YAML::Node extri = LoadOpenCvYaml(extri_path);
   std::vector<Camera> cameras;
   try {
     for (const std::string& name : ReadNames(intri, intri_path)) {
@@ -155,9 +180,10 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
       internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
       cameras.push_back(camera);
     }
-  } catch (const cv::Exception& error) {
-    // An OpenCV assertion that the checks above did not foresee still ends in one Error.
-    throw Error(intri_path + " / " + extri_path, "malformed OpenCV YAML/XML file: " + error.msg);
+  } catch (const YAML::Exception& error) {
+    // A yaml-cpp failure that the checks above did not foresee still ends in one Error.
+    throw Error(intri_path + " / " + extri_path,
+                std::string("malformed OpenCV YAML file: ") + error.what());
   }
   internal::RequireUniqueCameraNames(cameras, intri_path);
   return cameras;

@@ -16,13 +16,14 @@ using testing_util::ExpectErrorMentions;
 using testing_util::MakeTempDir;
 using testing_util::WriteText;
 
-// OpenCV's YAML parser threw std::length_error on this intri.yml.
+// OpenCV's YAML parser threw std::length_error on this intri.yml (read with yaml-cpp now, it is
+// not a mapping of keys).
 TEST(FuzzRegression, IntriYmlThatMadeOpenCvThrowALengthError) {
   const std::string dir = MakeTempDir("fuzz_intri");
   WriteText(dir + "/intri.yml", std::string("%YAML:1.\n   t:d\n   :\x01", 21));
   WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
-                      {dir + "/intri.yml", "malformed OpenCV YAML/XML file"});
+                      {dir + "/intri.yml", "top level must be a mapping"});
 }
 
 // A top level that is a list: OpenCV asserted (cv::Exception) when a key was looked up in it.
@@ -42,7 +43,7 @@ TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
             "5\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
   WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
-                      {dir + "/intri.yml", "K_01"});
+                      {dir + "/intri.yml", "malformed OpenCV YAML file"});
   WriteText(dir + "/intri.yml",
             "%YAML:1.0\n---\nnames: [\"01\"]\nK_01: !!opencv-matrix\n   rows: 3\n   cols: "
             "300000\n   dt: d\n   data: [ 60., 0., 31.5, 0., 60., 23.5, 0., 0., 1. ]\n");
@@ -50,8 +51,8 @@ TEST(FuzzRegression, IntriYmlWithADamagedMatrixSize) {
                       {dir + "/intri.yml", "K_01", "3x300000", "at most 16"});
 }
 
-// OpenCV 4.6's YAML parser looped forever on this intri.yml: it reads the NUL byte as the end of
-// its buffer. Text files with a NUL byte are refused before OpenCV sees them.
+// OpenCV 4.6's YAML parser looped forever on this intri.yml: it read the NUL byte as the end of its
+// buffer. A text file with a NUL byte is damaged, and is refused as such.
 TEST(FuzzRegression, IntriYmlWithANulByteThatMadeOpenCvLoopForever) {
   const std::string dir = MakeTempDir("fuzz_intri_nul");
   std::string bytes = "%YAML:1.\xd8";  // a literal of its own: "\xd8AML" would be one escape
@@ -62,6 +63,33 @@ TEST(FuzzRegression, IntriYmlWithANulByteThatMadeOpenCvLoopForever) {
   WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
   ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
                       {dir + "/intri.yml", "NUL byte at offset 16"});
+}
+
+// OpenCV 4.6's YAML parser never returned on these 20 plain ASCII bytes either: intri/extri files
+// are read with yaml-cpp since.
+TEST(FuzzRegression, IntriYmlThatMadeOpenCvLoopForeverWithoutANulByte) {
+  const std::string dir = MakeTempDir("fuzz_intri_loop");
+  WriteText(dir + "/intri.yml", "%YAML:1.\n  -\"\"\n,  -\n");
+  WriteText(dir + "/extri.yml", "%YAML:1.0\n---\nT_01: 0\n");
+  ExpectErrorMentions([&] { ReadIntriExtri(dir + "/intri.yml", dir + "/extri.yml"); },
+                      {dir + "/intri.yml", "top level must be a mapping"});
+}
+
+// A camera name with bytes that are not UTF-8 and a control character read, but came back
+// different from a round trip through WriteCamerasYaml: such names are refused.
+TEST(FuzzRegression, CameraNamesThatAreNotPrintableUtf8) {
+  const std::string dir = MakeTempDir("fuzz_camera_name");
+  const std::string camera =
+      "    width: 64\n    height: 47\n    K: [60, 0, 31.5, 0, 60, 23.5, 0, 0, 1]\n"
+      "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 3]\n";
+  for (const std::string& name : {std::string("cam0k\xff\xff\xff\x0bk"), std::string("a\tb"),
+                                  std::string("../up"), std::string("\xed\xa0\x80")}) {
+    WriteText(dir + "/cameras.yaml", "cameras:\n  - name: \"" + name + "\"\n" + camera);
+    ExpectErrorMentions([&] { ReadCamerasYaml(dir + "/cameras.yaml"); },
+                        {dir + "/cameras.yaml", "printable UTF-8"});
+  }
+  WriteText(dir + "/cameras.yaml", "cameras:\n  - name: \"caméra 1\"\n" + camera);
+  EXPECT_EQ(ReadCamerasYaml(dir + "/cameras.yaml").at(0).name, "caméra 1");
 }
 
 // YAML allows a list or a mapping as a key; yaml-cpp's conversion of it to a string threw
