@@ -42,7 +42,8 @@ void WriteCamerasYaml(const std::vector<Camera>& cameras, const std::string& pat
 // Cameras are returned in order of their first IMAGE_ID.
 std::vector<Camera> ReadColmapTextModel(const std::string& folder);
 
-// The OpenCV FileStorage pair intri.yml / extri.yml of ZJU-MoCap and EasyMocap: the `names` list
+// The pair intri.yml / extri.yml of ZJU-MoCap and EasyMocap, as OpenCV's FileStorage writes it in
+// YAML (read with yaml-cpp: OpenCV's own parser can hang on a damaged file): the `names` list
 // (in intri.yml), K_<cam>, dist_<cam> (1xN or Nx1 with N <= 5, missing coefficients are zero),
 // R_<cam> (a Rodrigues rotation vector) or Rot_<cam> (a 3x3 matrix, preferred when both are
 // present), T_<cam> (metres). The image size comes from H_<cam> / W_<cam> in intri.yml when
