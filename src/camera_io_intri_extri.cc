@@ -25,7 +25,7 @@ struct OpenCvMatrix {
   bool empty() const { return data.empty(); }
 };
 
-// YAML and XML are text: a NUL byte means a damaged or binary file.
+// A YAML file is text: a NUL byte means a damaged or binary file.
 void RequireNoNulByte(const std::string& path, const std::string& text) {
   const size_t nul = text.find('\0');
   Require(nul == std::string::npos, path,
