@@ -95,8 +95,17 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
 void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
   schema->AddChoice("energy.similarity", &energy->similarity,
                     "paper: the paper's E_sim as printed; surface_color: each surface Gaussian's "
-                    "colour against the image around its projection (peaks at the truth).",
-                    {"paper", "surface_color"});
+                    "colour against the image around its projection (peaks at the truth); "
+                    "consensus: the cameras that see a patch agree on its normalised colours (no "
+                    "reference colours).",
+                    {"paper", "surface_color", "consensus"});
+  schema->AddDouble("energy.consensus.contrast_floor", &energy->consensus.contrast_floor,
+                    "Consensus similarity: patches with less contrast than this (colour units) "
+                    "are not normalised to unit variance.",
+                    1e-6, 1.0);
+  schema->AddInt("energy.consensus.min_cameras", &energy->consensus.min_cameras,
+                 "Consensus similarity: cameras that must see a whole patch for it to count.", 2,
+                 64);
   schema->AddChoice("energy.overlap", &energy->overlap,
                     "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
                     "patch (image Gaussians as the squares they stand for).",

@@ -1,12 +1,12 @@
 #include "finecap/frame_energy.h"
 
+#include "finecap/consensus_similarity.h"
 #include "finecap/error.h"
 #include "finecap/input_prior.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
 
 namespace finecap {
-
 
 namespace {
 
@@ -36,11 +36,32 @@ std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
   return views;
 }
 
+// For each surface Gaussian, the surface Gaussians one edge away on the mesh.
+std::vector<std::vector<int>> SurfaceOneRings(const SurfaceGaussians& surface,
+                                              const VertexNeighbourhoods& neighbourhoods) {
+  std::vector<int> surface_of_vertex(neighbourhoods.num_vertices(), -1);
+  for (int s = 0; s < surface.size(); ++s) surface_of_vertex[surface.vertex_ids[s]] = s;
+  std::vector<std::vector<int>> rings(surface.size());
+  for (int s = 0; s < surface.size(); ++s) {
+    const int v = surface.vertex_ids[s];
+    for (int e = neighbourhoods.offsets[v]; e < neighbourhoods.offsets[v + 1]; ++e) {
+      const int j = surface_of_vertex[neighbourhoods.neighbours[e]];
+      if (neighbourhoods.edge_distances[e] == 1 && j >= 0) rings[s].push_back(j);
+    }
+  }
+  return rings;
+}
+
 std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
                                                const std::vector<EnergyView>& views,
+                                               const VertexNeighbourhoods& neighbourhoods,
                                                const EnergyOptions& options) {
   const OverlapForm form = ParseOverlapForm(options.overlap);
   if (options.similarity == "paper") return std::make_unique<PaperSimilarity>(surface, views, form);
+  if (options.similarity == "consensus") {
+    return std::make_unique<ConsensusSimilarity>(
+        surface, views, SurfaceOneRings(surface, neighbourhoods), form, options.consensus);
+  }
   return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
 }
 
@@ -51,7 +72,7 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
     : surface_(std::move(surface)),
       options_(Checked(options)),
       views_(BuildViews(surface_, cameras, options_)),
-      similarity_(MakeSimilarity(surface_, views_, options_)),
+      similarity_(MakeSimilarity(surface_, views_, neighbourhoods, options_)),
       regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
                    options_.RegUnitScale()) {
   // The data curvature is measured once, at the input surface, so that the prior is a fixed

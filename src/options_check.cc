@@ -25,8 +25,10 @@ void RefineOptions::Check() const {
 }
 
 void EnergyOptions::Check() const {
-  Require(similarity == "paper" || similarity == "surface_color", "energy.similarity",
-          "'" + similarity + "' is not one of: paper, surface_color");
+  Require(similarity == "paper" || similarity == "surface_color" || similarity == "consensus",
+          "energy.similarity",
+          "'" + similarity + "' is not one of: paper, surface_color, consensus");
+  consensus.Check();
   ParseOverlapForm(overlap);
   Require(color_cutoff > 0.0, "energy.color_cutoff", "must be positive");
   Require(reach_sigmas > 0.0, "energy.reach_sigmas", "must be positive");
@@ -38,6 +40,11 @@ void EnergyOptions::Check() const {
   Require(confidence_opening >= 0, "energy.confidence_opening", "must be non-negative");
   Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
   Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
+}
+
+void ConsensusOptions::Check() const {
+  Require(contrast_floor > 0.0, "energy.consensus.contrast_floor", "must be positive");
+  Require(min_cameras >= 2, "energy.consensus.min_cameras", "must be at least 2");
 }
 
 void SolverOptions::Check() const {

@@ -94,8 +94,18 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
   for (const Camera& camera : input.cameras) names.push_back(camera.name);
   frame.images = BuildFrameImageGaussians(input.images, {}, options.image, names);
 
-  SurfaceGaussians surface =
-      MakeSurfaceGaussians(frame.fine.vertices, frame.normals, model.refined_vertices(), colors);
+  // The consensus similarity compares the cameras of this frame with each other; the colours
+  // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this
+  // frame's own, taken as the reference frame's are, so no frame depends on another's surface.
+  const ReferenceColors frame_colors =
+      options.energy.similarity == "consensus"
+          ? ComputeModelReferenceColors(frame.fine.vertices, frame.normals, input.cameras,
+                                        frame.images, visible, options.sigma_hat,
+                                        ParseOverlapForm(options.energy.overlap),
+                                        options.energy.reach_sigmas)
+          : colors;
+  SurfaceGaussians surface = MakeSurfaceGaussians(frame.fine.vertices, frame.normals,
+                                                  model.refined_vertices(), frame_colors);
   std::vector<CameraInput> cameras(input.cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     cameras[c].camera = input.cameras[c];

@@ -71,21 +71,29 @@ SurfaceColorSimilarity::SurfaceColorSimilarity(const SurfaceGaussians& surface,
   observation_begin_.push_back(static_cast<int>(observations_.size()));
 }
 
-void SurfaceColorSimilarity::Residual(int camera, int row, double k, Eigen::Vector3d* residual,
-                                      Eigen::Vector3d* derivative) const {
-  const EnergyView& view = views_[camera];
+Eigen::Vector3d ImageColorOfPairs(const EnergyView& view, const SurfaceGaussians& surface, int row,
+                                  double k, OverlapForm form, const Eigen::Vector3d& fallback,
+                                  Eigen::Vector3d* derivative) {
   const CameraPairs& pairs = view.pairs;
   const int s = pairs.surface_ids[row];
   const ProjectedGaussian projected = ProjectSurfaceGaussian(
-      view.camera, surface_.base.col(s), surface_.normals.col(s), k, surface_.sigma_hat);
-  const Eigen::Vector3d own = surface_.colors[s].cast<double>();
-  ColorAccumulator accumulator(own);
+      view.camera, surface.base.col(s), surface.normals.col(s), k, surface.sigma_hat);
+  ColorAccumulator accumulator(fallback);
   for (int p = pairs.begin[row]; p < pairs.begin[row + 1]; ++p) {
-    accumulator.Add(form_, projected, (*view.image)[pairs.image_ids[p]], derivative != nullptr);
+    accumulator.Add(form, projected, (*view.image)[pairs.image_ids[p]], derivative != nullptr);
   }
-  const Eigen::Vector3d predicted = accumulator.Mean();
+  if (derivative != nullptr) *derivative = accumulator.MeanDerivative();
+  return accumulator.Mean();
+}
+
+void SurfaceColorSimilarity::Residual(int camera, int row, double k, Eigen::Vector3d* residual,
+                                      Eigen::Vector3d* derivative) const {
+  const EnergyView& view = views_[camera];
+  const Eigen::Vector3d own = surface_.colors[view.pairs.surface_ids[row]].cast<double>();
+  const Eigen::Vector3d predicted =
+      ImageColorOfPairs(view, surface_, row, k, form_, own, derivative);
   *residual = scale_ * (predicted - own);
-  if (derivative != nullptr) *derivative = scale_ * accumulator.MeanDerivative();
+  if (derivative != nullptr) *derivative *= scale_;
 }
 
 double SurfaceColorSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {

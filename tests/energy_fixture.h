@@ -118,7 +118,7 @@ using EnergyForm = std::tuple<std::string, std::string>;
 
 // Each similarity with the printed and the exact overlap.
 inline auto AllEnergyForms() {
-  return ::testing::Combine(::testing::Values("paper", "surface_color"),
+  return ::testing::Combine(::testing::Values("paper", "surface_color", "consensus"),
                             ::testing::Values("printed", "exact"));
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
+#include "finecap/consensus_similarity.h"
 #include "finecap/frame_energy.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
@@ -102,6 +103,101 @@ TEST(SurfaceColorSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
     for (double r : residuals) sum += r * r;
   }
   EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
+}
+
+TEST(ConsensusSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("consensus", "printed"));
+  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.005, 4);
+  SimilarityTerm& term = energy.similarity();
+  ASSERT_GT(term.residual_blocks().size(), 10u);
+  term.PrepareResiduals(k, false);
+  double sum = 0.0;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    std::vector<double> residuals(term.residual_blocks()[b].num_residuals);
+    term.BlockResiduals(b, residuals.data(), nullptr);
+    for (double r : residuals) sum += r * r;
+  }
+  EXPECT_GT(sum, 0.0);
+  EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
+}
+
+// A camera's gain and offset (per channel, as exposure and white balance) change each block's
+// weight but not the direction of its residual vector: the disagreement the solver sees is the
+// same up to a factor per block, so its optimum does not move.
+TEST(ConsensusSimilarityTest, IgnoresEachCamerasGainAndOffset) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 3, 8);
+  EnergyOptions options = Options("consensus", "printed");
+  options.consensus.contrast_floor = 1e-6;
+  const Eigen::VectorXd k = RandomK(scene.surface.size(), 0.004, 2);
+  const auto residuals_of = [&](const EnergyScene& s) {
+    FrameEnergy energy(s.surface, s.cameras, s.neighbourhoods, options);
+    SimilarityTerm& term = energy.similarity();
+    term.PrepareResiduals(k, false);
+    std::vector<std::vector<double>> all;
+    for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+      all.emplace_back(term.residual_blocks()[b].num_residuals);
+      term.BlockResiduals(b, all.back().data(), nullptr);
+    }
+    return all;
+  };
+  const auto plain = residuals_of(scene);
+  // Camera 1 twice as bright in red, 0.7 times in blue, with offsets.
+  std::vector<ImageGaussian> gaussians;
+  for (int i = 0; i < scene.images[1]->size(); ++i) {
+    ImageGaussian g = (*scene.images[1])[i];
+    g.color[0] = 2.0f * g.color[0] + 0.1f;
+    g.color[1] = g.color[1] - 0.2f;
+    g.color[2] = 0.7f * g.color[2];
+    gaussians.push_back(g);
+  }
+  EnergyScene changed = std::move(scene);
+  changed.images[1] = std::make_unique<ImageGaussians>(
+      changed.cameras[1].camera.width, changed.cameras[1].camera.height, ColorSpace::kNormalizedRgb,
+      gaussians, "test");
+  changed.cameras[1].image = changed.images[1].get();
+  const auto adjusted = residuals_of(changed);
+  ASSERT_EQ(plain.size(), adjusted.size());
+  ASSERT_GT(plain.size(), 10u);
+  for (size_t b = 0; b < plain.size(); ++b) {
+    // Per channel, the residuals of a block scale by one factor (the weight's change).
+    for (int channel = 0; channel < 3; ++channel) {
+      double dot = 0.0, plain_norm = 0.0, adjusted_norm = 0.0;
+      for (size_t r = channel; r < plain[b].size(); r += 3) {
+        dot += plain[b][r] * adjusted[b][r];
+        plain_norm += plain[b][r] * plain[b][r];
+        adjusted_norm += adjusted[b][r] * adjusted[b][r];
+      }
+      if (plain_norm < 1e-20) continue;
+      EXPECT_NEAR(dot / std::sqrt(plain_norm * adjusted_norm), 1.0, 1e-6)
+          << "block " << b << " channel " << channel;
+    }
+  }
+}
+
+// A plain surface (every image Gaussian the same colour) gives the consensus nothing to agree
+// on: no weight, no residual, no pull anywhere.
+TEST(ConsensusSimilarityTest, PlainSurfaceCarriesNoWeight) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 3, 5);
+  for (auto& image : scene.images) {
+    std::vector<ImageGaussian> gaussians;
+    for (int i = 0; i < image->size(); ++i) {
+      ImageGaussian g = (*image)[i];
+      g.color[0] = 0.4f, g.color[1] = 0.5f, g.color[2] = 0.6f;
+      gaussians.push_back(g);
+    }
+    image = std::make_unique<ImageGaussians>(image->width(), image->height(),
+                                             ColorSpace::kNormalizedRgb, gaussians, "test");
+  }
+  for (size_t c = 0; c < scene.cameras.size(); ++c) scene.cameras[c].image = scene.images[c].get();
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("consensus", "printed"));
+  Eigen::VectorXd gradient;
+  const double value =
+      energy.similarity().Evaluate(RandomK(scene.surface.size(), 0.004, 1), &gradient);
+  EXPECT_NEAR(value, 0.0, 1e-20);
+  EXPECT_LT(gradient.cwiseAbs().maxCoeff(), 1e-12);
 }
 
 // Near the min() clamp: scale one camera's image Gaussians so that the overlap sums sit just

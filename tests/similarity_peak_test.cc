@@ -63,15 +63,20 @@ FrameInput Render(const Mesh& flat, const Mesh& shown, const std::vector<Camera>
 
 // The amplitude a in [0, 2 kAmplitude] where the similarity of the flat plane displaced by
 // a * shape(x) is largest, the images showing the flat plane displaced by kAmplitude * shape(x).
+// The reference frame shows the flat plane (exact reference colours) unless
+// `folded_reference`: then it shows the same folds as the frame, as in a real capture, where the
+// input mesh of the reference frame is as coarse as any other.
 template <typename Shape>
 double BestAmplitude(const RefineOptions& options, const Mesh& flat,
-                     const std::vector<Camera>& cameras, const Shape& shape_of_x) {
+                     const std::vector<Camera>& cameras, const Shape& shape_of_x,
+                     bool folded_reference = false) {
   const SequenceModel model(flat, {}, options, "plane");
-  const ReferenceColors colors = ComputeSequenceColors(model, Render(flat, flat, cameras), options);
   Mesh shown = flat;
   for (int v = 0; v < shown.num_vertices(); ++v) {
     shown.vertices(2, v) -= kAmplitude * shape_of_x(shown.vertices(0, v));
   }
+  const ReferenceColors colors =
+      ComputeSequenceColors(model, Render(flat, folded_reference ? shown : flat, cameras), options);
   PreparedFrame frame = PrepareFrame(model, colors, Render(flat, shown, cameras), options);
   const FrameEnergy& energy = *frame.energy;
   Eigen::VectorXd shape(energy.num_parameters());
@@ -97,11 +102,14 @@ class SimilarityPeakTest : public ::testing::Test {
     paper_.reference_colors = "pixels";
     paper_.image.color_space = ColorSpace::kHsv;
     paper_.image.min_leaf_size = 4;
+    consensus_ = ours_;
+    consensus_.energy.similarity = "consensus";
+    consensus_.image.color_space = ColorSpace::kNormalizedRgb;
   }
 
   Mesh flat_;
   std::vector<Camera> cameras_;
-  RefineOptions ours_, paper_;
+  RefineOptions ours_, paper_, consensus_;
 };
 
 // The plane moved as a whole along its normal: both similarities must find the offset.
@@ -119,6 +127,21 @@ TEST_F(SimilarityPeakTest, DefaultSimilarityPeaksAtTheTrueFoldAmplitude) {
       "%.2f mm\n",
       1000 * kAmplitude, 1000 * ours, 1000 * papers);
   EXPECT_NEAR(ours, kAmplitude, 0.2 * kAmplitude);
+}
+
+// With folds already in the reference frame, reference colours belong to the wrong surface
+// points; the consensus similarity uses none and must still find the fold.
+TEST_F(SimilarityPeakTest, ConsensusPeaksAtTheFoldWithoutAnExactReferenceFrame) {
+  const double consensus = BestAmplitude(consensus_, flat_, cameras_, Fold, true);
+  const double surface_color = BestAmplitude(ours_, flat_, cameras_, Fold, true);
+  std::printf(
+      "folds in the reference frame, true amplitude %.1f mm: consensus peaks at %.2f mm, "
+      "surface_color at %.2f mm\n",
+      1000 * kAmplitude, 1000 * consensus, 1000 * surface_color);
+  EXPECT_NEAR(consensus, kAmplitude, 0.2 * kAmplitude);
+  EXPECT_NEAR(BestAmplitude(
+                  consensus_, flat_, cameras_, [](double) { return 1.0; }, true),
+              kAmplitude, 0.1 * kAmplitude);
 }
 
 }  // namespace

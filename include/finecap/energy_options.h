@@ -6,13 +6,27 @@
 
 namespace finecap {
 
+// Options of the consensus similarity (consensus_similarity.h).
+struct ConsensusOptions {
+  // epsilon of the per-camera normalisation, in colour units: patches whose contrast is below it
+  // are not stretched to unit variance, so image noise on plain cloth is not amplified.
+  // Default 0.005 (about 1.3 grey levels of 255).
+  double contrast_floor = 0.005;
+  // Cameras that must see a whole patch for it to count. At least 2. Default 2.
+  int min_cameras = 2;
+
+  void Check() const;
+};
+
 struct EnergyOptions {
   // Which similarity E_sim measures:
   //  "paper":         the paper's E_sim as printed, with the min() clamp per image Gaussian;
   //  "surface_color": each surface Gaussian's colour against the image colour around its
   //                   projection, the overlap-weighted mean of the image Gaussians' colours (a
   //                   closed-form least-squares residual per surface Gaussian and camera; see
-  //                   the README for why it peaks at the true surface where the paper's does not).
+  //                   the README for why it peaks at the true surface where the paper's does not);
+  //  "consensus":     the cameras that see a patch of surface Gaussians must agree on its
+  //                   normalised colours; no reference colours (consensus_similarity.h).
   // Default "surface_color" (measured with `finecap probe` and `finecap refine`, see the README).
   std::string similarity = "surface_color";
   // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
@@ -41,6 +55,8 @@ struct EnergyOptions {
   // RMS; 10.3 mm without the pull) and the textured part improves too (5.39 -> 4.17 mm), while
   // synth_skirt, textured throughout, is all but unchanged (2.52 -> 2.54 mm).
   double confidence_prior = 300.0;
+  // The consensus similarity's options.
+  ConsensusOptions consensus;
   // Colour variation, as a fraction of its median, below which the cloth counts as plain (the
   // plainness is exp(-V / (threshold * median V))). Default 0.05.
   double confidence_threshold = 0.05;

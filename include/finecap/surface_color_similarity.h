@@ -35,6 +35,13 @@ namespace finecap {
 Eigen::Vector3d ImageColorAround(const ImageGaussians& image, const ProjectedGaussian& projected,
                                  OverlapForm form, double reach_sigmas);
 
+// p_sc at displacement k of the surface Gaussian in row `row` of `view`'s pair list, over the
+// pairs of that row, and, when `derivative` is not null, dp_sc/dk. Where no image Gaussian is in
+// reach the colour tends to `fallback`.
+Eigen::Vector3d ImageColorOfPairs(const EnergyView& view, const SurfaceGaussians& surface, int row,
+                                  double k, OverlapForm form, const Eigen::Vector3d& fallback,
+                                  Eigen::Vector3d* derivative);
+
 class SurfaceColorSimilarity : public SimilarityTerm {
  public:
   // `views` must have been built without colour weights (PairOptions::color_cutoff <= 0); both

@@ -1,0 +1,94 @@
+// A similarity that needs no reference colours: the cameras that see a small patch of the surface
+// must agree on what it looks like, up to each camera's gain and offset.
+//
+// In camera c, a surface Gaussian j displaced by k along its normal shows
+// p_jc(k) = sum_i E_ij eta_i / sum_i E_ij, the image model blurred by the projected Gaussian and
+// read at its centre (surface_color_similarity.h). The patch of surface Gaussian s is s with its
+// one-ring neighbours P(s) on the mesh, all displaced by the same k_s along their own normals: a
+// piece of the input surface moved as a whole, as a window is moved in plane-sweep stereo. In each
+// camera that sees the whole patch, its colours are normalised per channel, as in a normalised
+// cross-correlation,
+//
+//   z_jc = (p_jc(k_s) - mean_{P(s)} p_c) / sqrt(var_{P(s)} p_c + epsilon^2),
+//
+// so that a camera's exposure, gain, offset and white balance do not count as disagreement, and
+// the residuals ask every camera's normalised patch to equal the cameras' mean,
+//
+//   r_sjc = w_s (z_jc - mean_c z_jc) / sqrt(n_c),     E_sim = -1/2 sum |r|^2.
+//
+// This is surface_color with the colour of every Gaussian an unknown eliminated in closed form,
+// on patches instead of single colours. w_s is the patch's contrast at the input surface (the
+// root mean variance over its cameras, per channel, fixed for the frame): plain cloth, whose
+// normalised colours are noise, carries no weight.
+//
+// Why the patch moves as a whole: with every member at its own k, each member could find a chance
+// match of its single blurred colour along its epipolar line (single-pixel stereo), and the
+// solver found configurations that agree better than the true surface (measured on synth_skirt:
+// refined RMS above the input's). A patch that moves with one k must match as a window. Each block
+// then depends on k_s alone, so the least-squares normal equations are diagonal but for the
+// regulariser, as for surface_color.
+//
+// Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
+// patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
+// a Gaussian seen by fewer has no data term and follows the regulariser.
+#ifndef FINECAP_CONSENSUS_SIMILARITY_H_
+#define FINECAP_CONSENSUS_SIMILARITY_H_
+
+#include <vector>
+
+#include "finecap/energy_options.h"
+#include "finecap/gaussian_overlap.h"
+#include "finecap/similarity.h"
+#include "finecap/surface_gaussians.h"
+
+namespace finecap {
+
+class ConsensusSimilarity : public SimilarityTerm {
+ public:
+  // `one_rings[s]` lists the surface Gaussians adjacent to s on the mesh (not s itself). `views`
+  // must have been built without colour weights; `surface` and `views` must outlive this object.
+  ConsensusSimilarity(const SurfaceGaussians& surface, const std::vector<EnergyView>& views,
+                      const std::vector<std::vector<int>>& one_rings, OverlapForm form,
+                      const ConsensusOptions& options);
+
+  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
+  const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
+  void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
+  void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+
+  // The weight w_s of each block, per channel (the patch's contrast at the input surface).
+  const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
+
+ private:
+  // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
+  // member displaced by k along its own normal.
+  void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
+                   std::vector<Eigen::Vector3d>* derivatives) const;
+  // The per-channel root mean variance of block b's patch over its cameras at the input surface.
+  Eigen::Vector3d PatchContrast(int b) const;
+  // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
+  // their derivatives.
+  void BlockAt(int b, double k, double* residuals, double* jacobian) const;
+
+  const SurfaceGaussians& surface_;
+  const std::vector<EnergyView>& views_;
+  OverlapForm form_;
+  ConsensusOptions options_;
+  double scale_;  // 1 / sqrt(n_c).
+
+  std::vector<ResidualBlock> blocks_;  // One per patch; its parameter: the centre's k.
+  // Block b's cameras are cameras_[camera_begin_[b] ..); rows_[a] (same index a) holds, for each
+  // patch member (centre first), its row in that camera's pair list.
+  std::vector<int> camera_begin_;
+  std::vector<int> cameras_;
+  std::vector<std::vector<int>> rows_;
+  std::vector<Eigen::Vector3d> weights_;
+
+  // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
+  std::vector<long> residual_begin_;
+  std::vector<double> residuals_, jacobians_;
+};
+
+}  // namespace finecap
+
+#endif  // FINECAP_CONSENSUS_SIMILARITY_H_

@@ -1,0 +1,197 @@
+#include "finecap/consensus_similarity.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "finecap/error.h"
+#include "finecap/surface_color_similarity.h"
+
+namespace finecap {
+namespace {
+
+// A patch needs a centre and at least this many neighbours to have a shape worth comparing.
+constexpr int kMinPatchNeighbours = 3;
+
+// Row of each surface Gaussian in a camera's pair list, -1 where the camera does not see it.
+std::vector<int> RowsOf(const CameraPairs& pairs, int num_surface) {
+  std::vector<int> rows(num_surface, -1);
+  for (int row = 0; row < static_cast<int>(pairs.surface_ids.size()); ++row) {
+    rows[pairs.surface_ids[row]] = row;
+  }
+  return rows;
+}
+
+// The colours q of a patch in one camera, normalised per channel, z_m = (q_m - mean) / deviation
+// with deviation = sqrt(variance + floor^2), and, when `dq` is given, dz/dk from dq/dk:
+// dz_m/dq_j = ((m == j) - 1/n - z_m z_j / n) / deviation, per channel.
+void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::Vector3d>* dq,
+               double floor, std::vector<Eigen::Vector3d>* z, std::vector<Eigen::Vector3d>* dz) {
+  const int n = static_cast<int>(q.size());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& value : q) mean += value;
+  mean /= n;
+  Eigen::Vector3d variance = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& value : q) variance += (value - mean).cwiseAbs2();
+  variance /= n;
+  const Eigen::Array3d inverse_deviation = (variance.array() + floor * floor).sqrt().inverse();
+  z->resize(n);
+  for (int m = 0; m < n; ++m) (*z)[m] = ((q[m] - mean).array() * inverse_deviation).matrix();
+  if (dq == nullptr) return;
+  Eigen::Array3d mean_derivative = Eigen::Array3d::Zero(), z_dot_dq = Eigen::Array3d::Zero();
+  for (int j = 0; j < n; ++j) {
+    mean_derivative += (*dq)[j].array() / n;
+    z_dot_dq += (*z)[j].array() * (*dq)[j].array() / n;
+  }
+  dz->resize(n);
+  for (int m = 0; m < n; ++m) {
+    (*dz)[m] =
+        (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) * inverse_deviation)
+            .matrix();
+  }
+}
+
+}  // namespace
+
+ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
+                                         const std::vector<EnergyView>& views,
+                                         const std::vector<std::vector<int>>& one_rings,
+                                         OverlapForm form, const ConsensusOptions& options)
+    : surface_(surface),
+      views_(views),
+      form_(form),
+      options_(options),
+      scale_(1.0 / std::sqrt(static_cast<double>(std::max<size_t>(views.size(), 1)))) {
+  options_.Check();
+  Require(one_rings.size() == static_cast<size_t>(surface.size()), "consensus similarity",
+          "one neighbour list per surface Gaussian expected");
+  std::vector<std::vector<int>> rows_of(views.size());
+  for (size_t c = 0; c < views.size(); ++c) rows_of[c] = RowsOf(views[c].pairs, surface.size());
+
+  for (int s = 0; s < surface.size(); ++s) {
+    if (static_cast<int>(one_rings[s].size()) < kMinPatchNeighbours) continue;
+    std::vector<int> patch = {s};
+    patch.insert(patch.end(), one_rings[s].begin(), one_rings[s].end());
+    std::vector<int> cameras;
+    std::vector<std::vector<int>> rows;
+    for (size_t c = 0; c < views.size(); ++c) {
+      std::vector<int> patch_rows;
+      for (int j : patch) patch_rows.push_back(rows_of[c][j]);
+      if (std::find(patch_rows.begin(), patch_rows.end(), -1) != patch_rows.end()) continue;
+      cameras.push_back(static_cast<int>(c));
+      rows.push_back(std::move(patch_rows));
+    }
+    if (static_cast<int>(cameras.size()) < options_.min_cameras) continue;
+    camera_begin_.push_back(static_cast<int>(cameras_.size()));
+    cameras_.insert(cameras_.end(), cameras.begin(), cameras.end());
+    for (auto& patch_rows : rows) rows_.push_back(std::move(patch_rows));
+    blocks_.push_back({{s}, 3 * static_cast<int>(cameras.size() * patch.size())});
+  }
+  camera_begin_.push_back(static_cast<int>(cameras_.size()));
+
+  residual_begin_.assign(1, 0);
+  for (const ResidualBlock& block : blocks_) {
+    residual_begin_.push_back(residual_begin_.back() + block.num_residuals);
+  }
+  weights_.resize(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) weights_[b] = PatchContrast(b);
+}
+
+void ConsensusSimilarity::PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
+                                      std::vector<Eigen::Vector3d>* derivatives) const {
+  const EnergyView& view = views_[cameras_[a]];
+  const std::vector<int>& rows = rows_[a];
+  const int n = static_cast<int>(rows.size());
+  colors->resize(n);
+  if (derivatives != nullptr) derivatives->resize(n);
+  for (int m = 0; m < n; ++m) {
+    const int j = view.pairs.surface_ids[rows[m]];
+    (*colors)[m] =
+        ImageColorOfPairs(view, surface_, rows[m], k, form_, surface_.colors[j].cast<double>(),
+                          derivatives != nullptr ? &(*derivatives)[m] : nullptr);
+  }
+}
+
+Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
+  Eigen::Vector3d variance = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> colors;
+  for (int a = camera_begin_[b]; a < camera_begin_[b + 1]; ++a) {
+    PatchColors(a, 0.0, &colors, nullptr);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& color : colors) mean += color / colors.size();
+    for (const Eigen::Vector3d& color : colors)
+      variance += (color - mean).cwiseAbs2() / colors.size();
+  }
+  return (variance / (camera_begin_[b + 1] - camera_begin_[b])).cwiseSqrt();
+}
+
+void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
+  const int num_cameras = camera_begin_[b + 1] - camera_begin_[b];
+  std::vector<std::vector<Eigen::Vector3d>> z(num_cameras), dz(num_cameras);
+  std::vector<Eigen::Vector3d> q, dq;
+  for (int a = 0; a < num_cameras; ++a) {
+    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr);
+    Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor, &z[a], &dz[a]);
+  }
+  const int n = static_cast<int>(z[0].size());
+  const Eigen::Vector3d weight = scale_ * weights_[b];
+  for (int m = 0; m < n; ++m) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), mean_derivative = Eigen::Vector3d::Zero();
+    for (int a = 0; a < num_cameras; ++a) {
+      mean += z[a][m] / num_cameras;
+      if (jacobian != nullptr) mean_derivative += dz[a][m] / num_cameras;
+    }
+    for (int a = 0; a < num_cameras; ++a) {
+      const Eigen::Vector3d r = weight.cwiseProduct(z[a][m] - mean);
+      std::copy_n(r.data(), 3, residuals + (a * n + m) * 3);
+      if (jacobian == nullptr) continue;
+      const Eigen::Vector3d d = weight.cwiseProduct(dz[a][m] - mean_derivative);
+      std::copy_n(d.data(), 3, jacobian + (a * n + m) * 3);
+    }
+  }
+}
+
+double ConsensusSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {
+  if (gradient != nullptr) *gradient = Eigen::VectorXd::Zero(k.size());
+  const int num_blocks = static_cast<int>(blocks_.size());
+  double sum_of_squares = 0.0;
+#pragma omp parallel reduction(+ : sum_of_squares)
+  {
+    std::vector<double> residuals, jacobian;
+#pragma omp for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      const int s = blocks_[b].parameters[0];
+      residuals.resize(blocks_[b].num_residuals);
+      jacobian.resize(residuals.size());
+      BlockAt(b, k[s], residuals.data(), gradient != nullptr ? jacobian.data() : nullptr);
+      double dcost = 0.0;
+      for (size_t r = 0; r < residuals.size(); ++r) {
+        sum_of_squares += residuals[r] * residuals[r];
+        if (gradient != nullptr) dcost += residuals[r] * jacobian[r];
+      }
+      // Each block owns one parameter: no two threads write the same entry.
+      if (gradient != nullptr) (*gradient)[s] = -dcost;
+    }
+  }
+  return -0.5 * sum_of_squares;
+}
+
+void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) {
+  residuals_.resize(residual_begin_.back());
+  jacobians_.resize(with_jacobians ? residual_begin_.back() : 0);
+  const int num_blocks = static_cast<int>(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    BlockAt(b, k[blocks_[b].parameters[0]], &residuals_[residual_begin_[b]],
+            with_jacobians ? &jacobians_[residual_begin_[b]] : nullptr);
+  }
+}
+
+void ConsensusSimilarity::BlockResiduals(int block, double* residuals, double* jacobian) const {
+  const long begin = residual_begin_[block];
+  const int num_residuals = blocks_[block].num_residuals;
+  std::copy_n(&residuals_[begin], num_residuals, residuals);
+  if (jacobian != nullptr) std::copy_n(&jacobians_[begin], num_residuals, jacobian);
+}
+
+}  // namespace finecap
