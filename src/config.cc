@@ -106,6 +106,17 @@ void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
   schema->AddInt("energy.consensus.min_cameras", &energy->consensus.min_cameras,
                  "Consensus similarity: cameras that must see a whole patch for it to count.", 2,
                  64);
+  schema->AddInt("energy.consensus.passes", &energy->consensus.passes,
+                 "Consensus similarity: solves per frame, each later one with patches shaped "
+                 "like the surface the one before found.",
+                 1, 10);
+  schema->AddInt("energy.consensus.patch_rings", &energy->consensus.patch_rings,
+                 "Consensus similarity: a patch is a surface Gaussian and its neighbours up to "
+                 "this many edges away (at most energy.reg_rings).",
+                 1, 4);
+  schema->AddBool("energy.consensus.gain_per_channel", &energy->consensus.gain_per_channel,
+                  "Consensus similarity: normalise each camera's gain per channel (white "
+                  "balance) instead of once for all channels (exposure).");
   schema->AddChoice("energy.overlap", &energy->overlap,
                     "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
                     "patch (image Gaussians as the squares they stand for).",

@@ -11,6 +11,10 @@ namespace {
 
 // A patch needs a centre and at least this many neighbours to have a shape worth comparing.
 constexpr int kMinPatchNeighbours = 3;
+// Table nodes per sigma_hat of displacement: a projected Gaussian moves by at most its own sigma
+// over sigma_hat of k, over which its blurred colour changes smoothly; at a third of that the
+// cubic interpolation's error is far below the image noise.
+constexpr double kNodesPerSigma = 3.0;
 
 // Row of each surface Gaussian in a camera's pair list, -1 where the camera does not see it.
 std::vector<int> RowsOf(const CameraPairs& pairs, int num_surface) {
@@ -21,19 +25,23 @@ std::vector<int> RowsOf(const CameraPairs& pairs, int num_surface) {
   return rows;
 }
 
-// The colours q of a patch in one camera, normalised per channel, z_m = (q_m - mean) / deviation
-// with deviation = sqrt(variance + floor^2), and, when `dq` is given, dz/dk from dq/dk:
-// dz_m/dq_j = ((m == j) - 1/n - z_m z_j / n) / deviation, per channel.
+// The colours q of a patch in one camera, normalised, z_m = (q_m - mean) / deviation with
+// deviation = sqrt(variance + floor^2), the mean per channel and the variance per channel or, when
+// `pooled`, over all three channels (one gain for the camera); and, when `dq` is given, dz/dk from
+// dq/dk: dz_m/dk = (dq_m/dk - mean dq/dk - z_m <z, dq/dk>) / deviation, where <z, dq/dk> is the
+// mean over the patch (and the channels, when pooled) of z_j dq_j/dk.
 void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::Vector3d>* dq,
-               double floor, std::vector<Eigen::Vector3d>* z, std::vector<Eigen::Vector3d>* dz) {
+               double floor, bool pooled, std::vector<Eigen::Vector3d>* z,
+               std::vector<Eigen::Vector3d>* dz) {
   const int n = static_cast<int>(q.size());
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Eigen::Vector3d& value : q) mean += value;
   mean /= n;
-  Eigen::Vector3d variance = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& value : q) variance += (value - mean).cwiseAbs2();
+  Eigen::Array3d variance = Eigen::Array3d::Zero();
+  for (const Eigen::Vector3d& value : q) variance += (value - mean).array().square();
   variance /= n;
-  const Eigen::Array3d inverse_deviation = (variance.array() + floor * floor).sqrt().inverse();
+  if (pooled) variance.setConstant(variance.mean());
+  const Eigen::Array3d inverse_deviation = (variance + floor * floor).sqrt().inverse();
   z->resize(n);
   for (int m = 0; m < n; ++m) (*z)[m] = ((q[m] - mean).array() * inverse_deviation).matrix();
   if (dq == nullptr) return;
@@ -42,11 +50,12 @@ void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::V
     mean_derivative += (*dq)[j].array() / n;
     z_dot_dq += (*z)[j].array() * (*dq)[j].array() / n;
   }
+  if (pooled) z_dot_dq.setConstant(z_dot_dq.mean());
   dz->resize(n);
   for (int m = 0; m < n; ++m) {
-    (*dz)[m] =
-        (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) * inverse_deviation)
-            .matrix();
+    (*dz)[m] = (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) *
+                inverse_deviation)
+                   .matrix();
   }
 }
 
@@ -55,7 +64,8 @@ void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::V
 ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
                                          const std::vector<EnergyView>& views,
                                          const std::vector<std::vector<int>>& one_rings,
-                                         OverlapForm form, const ConsensusOptions& options)
+                                         OverlapForm form, double k_max,
+                                         const ConsensusOptions& options)
     : surface_(surface),
       views_(views),
       form_(form),
@@ -92,24 +102,82 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
   for (const ResidualBlock& block : blocks_) {
     residual_begin_.push_back(residual_begin_.back() + block.num_residuals);
   }
+  shape_ = Eigen::VectorXd::Zero(surface.size());
+  BuildTables(k_max);
   weights_.resize(blocks_.size());
 #pragma omp parallel for schedule(dynamic, 64)
   for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) weights_[b] = PatchContrast(b);
 }
 
+void ConsensusSimilarity::BuildTables(double k_max) {
+  node_step_ = surface_.sigma_hat / kNodesPerSigma;
+  num_nodes_ = static_cast<int>(std::ceil(2.0 * k_max / node_step_)) + 1;
+  node_step_ = 2.0 * k_max / (num_nodes_ - 1);
+  node_k0_ = -k_max;
+  table_.resize(views_.size());
+  table_derivative_.resize(views_.size());
+  for (size_t c = 0; c < views_.size(); ++c) {
+    const EnergyView& view = views_[c];
+    const int num_rows = static_cast<int>(view.pairs.surface_ids.size());
+    table_[c].resize(long(num_rows) * num_nodes_);
+    table_derivative_[c].resize(long(num_rows) * num_nodes_);
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int row = 0; row < num_rows; ++row) {
+      const int j = view.pairs.surface_ids[row];
+      for (int g = 0; g < num_nodes_; ++g) {
+        const long entry = long(row) * num_nodes_ + g;
+        table_[c][entry] = ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_,
+                                             form_, surface_.colors[j].cast<double>(),
+                                             &table_derivative_[c][entry]);
+      }
+    }
+  }
+}
+
 void ConsensusSimilarity::PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
                                       std::vector<Eigen::Vector3d>* derivatives) const {
-  const EnergyView& view = views_[cameras_[a]];
+  const int c = cameras_[a];
   const std::vector<int>& rows = rows_[a];
   const int n = static_cast<int>(rows.size());
   colors->resize(n);
   if (derivatives != nullptr) derivatives->resize(n);
+  const EnergyView& view = views_[c];
+  const double centre_shape = shape_[view.pairs.surface_ids[rows[0]]];
   for (int m = 0; m < n; ++m) {
-    const int j = view.pairs.surface_ids[rows[m]];
-    (*colors)[m] =
-        ImageColorOfPairs(view, surface_, rows[m], k, form_, surface_.colors[j].cast<double>(),
-                          derivatives != nullptr ? &(*derivatives)[m] : nullptr);
+    const double member_k = k + shape_[view.pairs.surface_ids[rows[m]]] - centre_shape;
+    (*colors)[m] = Interpolate(c, rows[m], member_k, derivatives ? &(*derivatives)[m] : nullptr);
   }
+}
+
+Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
+                                                 Eigen::Vector3d* derivative) const {
+  // Cubic Hermite basis on the node interval holding k; beyond the table the colour stays at
+  // its end value.
+  const double x = std::clamp((k - node_k0_) / node_step_, 0.0, num_nodes_ - 1.0);
+  const int g = std::min(static_cast<int>(x), num_nodes_ - 2);
+  const double t = x - g, t2 = t * t, t3 = t2 * t;
+  const long entry = long(row) * num_nodes_ + g;
+  const Eigen::Vector3d& p0 = table_[c][entry];
+  const Eigen::Vector3d& p1 = table_[c][entry + 1];
+  const Eigen::Vector3d m0 = node_step_ * table_derivative_[c][entry];
+  const Eigen::Vector3d m1 = node_step_ * table_derivative_[c][entry + 1];
+  if (derivative != nullptr) {
+    const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
+    derivative->setZero();
+    if (inside) {
+      *derivative = ((6 * t2 - 6 * t) * p0 + (3 * t2 - 4 * t + 1) * m0 + (-6 * t2 + 6 * t) * p1 +
+                     (3 * t2 - 2 * t) * m1) /
+                    node_step_;
+    }
+  }
+  return (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * p1 +
+         (t3 - t2) * m1;
+}
+
+void ConsensusSimilarity::SetPatchShape(const Eigen::VectorXd& shape) {
+  Require(shape.size() == surface_.size(), "consensus similarity",
+          "one patch shape entry per surface Gaussian expected");
+  shape_ = shape;
 }
 
 Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
@@ -131,7 +199,8 @@ void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* ja
   std::vector<Eigen::Vector3d> q, dq;
   for (int a = 0; a < num_cameras; ++a) {
     PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr);
-    Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor, &z[a], &dz[a]);
+    Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor,
+              !options_.gain_per_channel, &z[a], &dz[a]);
   }
   const int n = static_cast<int>(z[0].size());
   const Eigen::Vector3d weight = scale_ * weights_[b];

@@ -36,20 +36,21 @@ std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
   return views;
 }
 
-// For each surface Gaussian, the surface Gaussians one edge away on the mesh.
-std::vector<std::vector<int>> SurfaceOneRings(const SurfaceGaussians& surface,
-                                              const VertexNeighbourhoods& neighbourhoods) {
+// For each surface Gaussian, the surface Gaussians at most `rings` edges away on the mesh (at most
+// as far as the neighbourhoods reach).
+std::vector<std::vector<int>> SurfaceRings(const SurfaceGaussians& surface,
+                                           const VertexNeighbourhoods& neighbourhoods, int rings) {
   std::vector<int> surface_of_vertex(neighbourhoods.num_vertices(), -1);
   for (int s = 0; s < surface.size(); ++s) surface_of_vertex[surface.vertex_ids[s]] = s;
-  std::vector<std::vector<int>> rings(surface.size());
+  std::vector<std::vector<int>> patches(surface.size());
   for (int s = 0; s < surface.size(); ++s) {
     const int v = surface.vertex_ids[s];
     for (int e = neighbourhoods.offsets[v]; e < neighbourhoods.offsets[v + 1]; ++e) {
       const int j = surface_of_vertex[neighbourhoods.neighbours[e]];
-      if (neighbourhoods.edge_distances[e] == 1 && j >= 0) rings[s].push_back(j);
+      if (neighbourhoods.edge_distances[e] <= rings && j >= 0) patches[s].push_back(j);
     }
   }
-  return rings;
+  return patches;
 }
 
 std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
@@ -60,7 +61,8 @@ std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
   if (options.similarity == "paper") return std::make_unique<PaperSimilarity>(surface, views, form);
   if (options.similarity == "consensus") {
     return std::make_unique<ConsensusSimilarity>(
-        surface, views, SurfaceOneRings(surface, neighbourhoods), form, options.consensus);
+        surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form, options.k_max,
+        options.consensus);
   }
   return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
 }

@@ -45,6 +45,8 @@ void EnergyOptions::Check() const {
 void ConsensusOptions::Check() const {
   Require(contrast_floor > 0.0, "energy.consensus.contrast_floor", "must be positive");
   Require(min_cameras >= 2, "energy.consensus.min_cameras", "must be at least 2");
+  Require(passes >= 1, "energy.consensus.passes", "must be at least 1");
+  Require(patch_rings >= 1, "energy.consensus.patch_rings", "must be at least 1");
 }
 
 void SolverOptions::Check() const {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 
+#include "finecap/consensus_similarity.h"
 #include "finecap/error.h"
 #include "finecap/frame_energy.h"
 #include "finecap/render.h"
@@ -121,6 +122,35 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 
 namespace {
 
+// Solve, and for the consensus similarity the further passes with patches shaped like the surface
+// found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
+// so that `worse` compares the frame by the energy it ended with.
+SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
+                               Eigen::VectorXd* k) {
+  const Eigen::VectorXd start = *k;
+  SolverSummary summary = Solve(energy, options.solver, k);
+  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
+  if (consensus == nullptr) return summary;
+  for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
+    consensus->SetPatchShape(*k);
+    const SolverSummary more = Solve(energy, options.solver, k);
+    summary.energy_end = more.energy_end;
+    summary.ls_cost_end = more.ls_cost_end;
+    summary.iterations += more.iterations;
+    summary.evaluations += more.evaluations;
+    summary.seconds += more.seconds;
+    summary.seconds_evaluation += more.seconds_evaluation;
+    summary.seconds_linear_solver += more.seconds_linear_solver;
+    summary.termination = more.termination;
+    summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
+  }
+  if (options.energy.consensus.passes > 1) {
+    summary.energy_start = energy->Evaluate(start, nullptr);
+    summary.ls_cost_start = LeastSquaresCost(energy, start);
+  }
+  return summary;
+}
+
 // Where the solve of a prepared frame starts: one k per surface Gaussian of `energy`.
 using StartingPointFunction = std::function<Eigen::VectorXd(FrameEnergy* energy)>;
 
@@ -150,7 +180,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     PreparedFrame frame = PrepareFrame(model, level_colors, input, level_options);
     *seconds_preparation += frame.seconds;
     if (k.size() == 0) k = starting_point(frame.energy.get());
-    const SolverSummary summary = Solve(frame.energy.get(), options.solver, &k);
+    const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
     totals->iterations += summary.iterations;
     totals->evaluations += summary.evaluations;
     totals->seconds += summary.seconds;
@@ -181,7 +211,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   // The frame got worse or better against where it started, before any level moved it.
   const Eigen::VectorXd initial = starting_point(&energy);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
-  result.summary = Solve(&energy, options.solver, &k);
+  result.summary = SolveFrameEnergy(&energy, options, &k);
   if (coarse_k.size() > 0) {
     result.summary.energy_start = energy.Evaluate(initial, nullptr);
     result.summary.ls_cost_start = LeastSquaresCost(&energy, initial);

@@ -28,6 +28,12 @@
 // then depends on k_s alone, so the least-squares normal equations are diagonal but for the
 // regulariser, as for surface_color.
 //
+// Speed: a member's colour is needed at the k of every patch it belongs to (about seven), so each
+// p_jc(k) is tabulated once per frame, with its derivative, at displacements sigma_hat / 3 apart
+// over [-k_max, k_max], and read between them by cubic Hermite interpolation (exact at the nodes,
+// C1 between them). The energy the solvers see is the interpolated one, and its Jacobians are
+// those of the interpolant, exactly.
+//
 // Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
 // patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
 // a Gaussian seen by fewer has no data term and follows the regulariser.
@@ -49,21 +55,30 @@ class ConsensusSimilarity : public SimilarityTerm {
   // must have been built without colour weights; `surface` and `views` must outlive this object.
   ConsensusSimilarity(const SurfaceGaussians& surface, const std::vector<EnergyView>& views,
                       const std::vector<std::vector<int>>& one_rings, OverlapForm form,
-                      const ConsensusOptions& options);
+                      double k_max, const ConsensusOptions& options);
 
   double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
 
+  // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
+  // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.
+  // One entry per surface Gaussian; zero (the input surface) until set.
+  void SetPatchShape(const Eigen::VectorXd& shape);
+
   // The weight w_s of each block, per channel (the patch's contrast at the input surface).
   const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
 
  private:
+  // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
+  void BuildTables(double k_max);
   // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
-  // member displaced by k along its own normal.
+  // member displaced by k along its own normal, interpolated in the tables.
   void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
                    std::vector<Eigen::Vector3d>* derivatives) const;
+  // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk.
+  Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
   // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
@@ -83,6 +98,12 @@ class ConsensusSimilarity : public SimilarityTerm {
   std::vector<int> cameras_;
   std::vector<std::vector<int>> rows_;
   std::vector<Eigen::Vector3d> weights_;
+
+  // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
+  double node_k0_ = 0.0, node_step_ = 1.0;
+  int num_nodes_ = 0;
+  std::vector<std::vector<Eigen::Vector3d>> table_, table_derivative_;
+  Eigen::VectorXd shape_;
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_;

@@ -14,6 +14,16 @@ struct ConsensusOptions {
   double contrast_floor = 0.005;
   // Cameras that must see a whole patch for it to count. At least 2. Default 2.
   int min_cameras = 2;
+  // Solves per frame: after the first, each patch moves as a piece of the surface the previous
+  // solve found instead of the input surface (ConsensusSimilarity::SetPatchShape), so that
+  // folds steeper than the input no longer bias the windows towards it. Default 2.
+  int passes = 2;
+  // Size of a patch: a surface Gaussian and its neighbours up to this many mesh edges away (at
+  // most energy.reg_rings, the neighbourhoods built). Default 1.
+  int patch_rings = 1;
+  // Whether each camera's gain is normalised per channel (white balance) or once for all three
+  // (exposure; its offsets stay per channel). Default true.
+  bool gain_per_channel = true;
 
   void Check() const;
 };
