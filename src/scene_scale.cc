@@ -1,6 +1,7 @@
 #include "finecap/scene_scale.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -52,13 +53,18 @@ ChosenLength Choose(const std::string& key, double factor, double scene_length, 
   return {key, *value, from_scene};
 }
 
-std::string Millimetres(double metres) {
+}  // namespace
+
+std::string LengthText(double metres) {
   std::ostringstream text;
-  text << std::setprecision(3) << 1000.0 * metres << " mm";
+  text << std::setprecision(3);
+  if (std::abs(metres) >= 1.0) {
+    text << metres << " m";
+  } else {
+    text << 1000.0 * metres << " mm";
+  }
   return text.str();
 }
-
-}  // namespace
 
 SceneScale MeasureSceneScale(const Mesh& fine, const std::vector<Camera>& cameras) {
   SceneScale scale;
@@ -107,12 +113,12 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int referen
 std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults) {
   const SceneScale& scale = defaults.scale;
   std::ostringstream text;
-  text << "scene length " << Millimetres(scale.length) << " = max(mean edge after subdivision "
-       << Millimetres(scale.mean_edge_length) << ", " << kFootprintsPerSceneLength
-       << " x pixel footprint " << Millimetres(scale.pixel_footprint) << "); ";
+  text << "scene length " << LengthText(scale.length) << " = max(mean edge after subdivision "
+       << LengthText(scale.mean_edge_length) << ", " << kFootprintsPerSceneLength
+       << " x pixel footprint " << LengthText(scale.pixel_footprint) << "); ";
   for (size_t i = 0; i < defaults.lengths.size(); ++i) {
     const ChosenLength& length = defaults.lengths[i];
-    text << (i ? ", " : "") << length.key << " " << Millimetres(length.value)
+    text << (i ? ", " : "") << length.key << " " << LengthText(length.value)
          << (length.from_scene ? " (auto)" : " (set)");
   }
   return text.str();

@@ -84,6 +84,9 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
 SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int reference_frame,
                                              RefineOptions* options);
 
+// A length for people: "0.716 mm", "207 mm", "1.18 m".
+std::string LengthText(double metres);
+
 // A line that says what was chosen and from what, e.g. "scene length 9.9 mm (mean edge 9.9 mm,
 // pixel footprint 3.0 mm); model.sigma_hat 6.93 mm (from the scene), energy.k_max 20 mm (set)".
 std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults);

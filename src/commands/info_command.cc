@@ -2,7 +2,6 @@
 // refining or writing anything. Every figure comes from the library functions a run uses.
 #include <cmath>
 #include <iostream>
-#include <sstream>
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
@@ -12,13 +11,6 @@
 
 namespace finecap {
 namespace {
-
-std::string Millimetres(double metres) {
-  std::ostringstream text;
-  text.precision(3);
-  text << 1000.0 * metres << " mm";
-  return text.str();
-}
 
 void PrintCameras(const Capture& capture, const ProblemSize& size) {
   std::cout << "cameras: " << capture.num_cameras() << ", read from " << capture.rig_source()
@@ -80,15 +72,16 @@ int RunInfo(const Config& configured) {
             << " faces; " << size.num_fine_vertices << " vertices after "
             << config.refine.subdivision_levels << " subdivision level(s)\n";
   const SceneScale& scale = defaults.scale;
-  std::cout << "scene: extent " << Millimetres(scale.diagonal)
+  std::cout << "scene: extent " << LengthText(scale.diagonal)
             << " (bounding-box diagonal), mean edge after subdivision "
-            << Millimetres(scale.mean_edge_length) << ", pixel footprint "
-            << Millimetres(scale.pixel_footprint) << ", scene length " << Millimetres(scale.length)
+            << LengthText(scale.mean_edge_length) << ", pixel footprint "
+            << LengthText(scale.pixel_footprint) << ", scene length " << LengthText(scale.length)
             << "\n";
   std::cout << "lengths:";
-  for (const ChosenLength& length : defaults.lengths) {
-    std::cout << " " << length.key << " " << Millimetres(length.value)
-              << (length.from_scene ? " (auto)" : " (set)") << ";";
+  for (size_t i = 0; i < defaults.lengths.size(); ++i) {
+    const ChosenLength& length = defaults.lengths[i];
+    std::cout << (i ? ", " : " ") << length.key << " " << LengthText(length.value)
+              << (length.from_scene ? " (auto)" : " (set)");
   }
   std::cout << "\n";
   std::cout << "vertices refined: " << size.num_surface_gaussians << " of "
