@@ -3,10 +3,12 @@
 #include "finecap/scene_scale.h"
 
 #include <cmath>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
+#include "finecap/capture.h"
 #include "test_meshes.h"
 
 namespace finecap {
@@ -112,6 +114,27 @@ TEST(SceneScale, SubdivisionShortensTheEdgesTheLengthsFollow) {
   ResolveSceneScaleDefaults(CentredGrid(0.04), {camera}, "grid.ply", &fine);
   // Loop subdivision halves the edges of a planar grid (its boundary stays straight).
   EXPECT_NEAR(fine.sigma_hat, 0.5 * coarse.sigma_hat, 0.02 * coarse.sigma_hat);
+}
+
+// The Middlebury temple (../shared/captures, a 10 cm object filmed from 0.6 m) gets lengths
+// proportionate to it, about a tenth of a person's.
+TEST(SceneScale, ASmallRealObjectGetsProportionateLengths) {
+  const std::string dir = FINECAP_SOURCE_DIR "/../shared/captures/middlebury_temple";
+  if (!std::filesystem::exists(dir)) {
+    GTEST_SKIP() << "the Middlebury temple capture is not at " << dir;
+  }
+  const Capture capture = Capture::Open(dir);
+  RefineOptions options;
+  const SceneScaleDefaults defaults = ResolveSceneScaleDefaults(capture, 0, &options);
+  // 640 x 480 pixels of focal 1520 at 0.55-0.65 m: about 0.4 mm per pixel.
+  EXPECT_NEAR(defaults.scale.pixel_footprint, 0.0004, 0.00005);
+  EXPECT_GT(defaults.scale.diagonal, 0.15);
+  EXPECT_LT(defaults.scale.diagonal, 0.25);
+  EXPECT_GT(options.sigma_hat, 0.0004);
+  EXPECT_LT(options.sigma_hat, 0.0012);
+  EXPECT_LT(options.energy.k_max, 0.004);
+  // A surface Gaussian still covers about 2 pixels.
+  EXPECT_GT(options.sigma_hat / defaults.scale.pixel_footprint, 1.5);
 }
 
 }  // namespace
