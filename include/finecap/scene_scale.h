@@ -11,14 +11,16 @@
 // image, of depth / focal length (the metres one pixel covers at the surface). The edge length
 // says how densely surface Gaussians sample the surface; the footprint floor keeps a Gaussian
 // wide enough (about 2 pixels) for the image model to see. Each length is a fixed multiple of s
-// (kSceneLengthFactors), chosen so that the person-sized presets keep the values finecap used
+// (SceneLengthFactors), chosen so that the person-sized presets keep the values finecap used
 // before it measured the scene (sigma_hat 7 mm, k_max 2 cm: synth_skirt's s is 11.4 mm).
 //
 // Also a guard against captures in the wrong unit. finecap's lengths are metres (its outputs,
 // the synthetic folds), so a capture in millimetres or centimetres would not fail anywhere: with
 // lengths set in metres its Gaussians would simply be 1000 or 100 times too small to see
 // anything. The size of the coarse mesh against sigma_hat tells the units apart: a performer in
-// metres spans a few hundred sigma_hat.
+// metres spans a few hundred sigma_hat. (Lengths that follow from the scene would fit a capture in
+// millimetres too, but its outputs would not be metres; the commands measure the mesh against
+// the person-sized 7 mm then, so such a capture is still refused.)
 #ifndef FINECAP_SCENE_SCALE_H_
 #define FINECAP_SCENE_SCALE_H_
 
