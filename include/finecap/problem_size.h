@@ -6,9 +6,13 @@
 // millions of pairs when the Gaussians are large against the image), and their length depends on
 // sigma_hat, k_max and the texture, so the forecast counts them: it builds the frame's image
 // Gaussians and the pairs of a sample of the surface Gaussians (every n-th, enough for a count
-// within a few per cent), without keeping them. The bytes per item below were measured with
-// bench/memory_forecast.sh (peak RSS against the forecast on synth_skirt, synth_demo and the
-// Middlebury temple).
+// within a few per cent), without keeping them. The bytes per item (problem_size.cc) were fitted
+// to the peak RSS of refinements of synth_skirt, synth_demo and the Middlebury temple, measured
+// with bench/memory_forecast.sh on 2 cores; a machine with many more cores keeps more per-thread
+// memory (stacks, allocator arenas). The forecast is that of the configured level: the coarser
+// levels of a coarse-to-fine schedule are solved before it and freed, and measured no higher
+// (synth_skirt and the temple with refine.coarse_to_fine.levels 2: 3 % and 2 % above the
+// forecast), but they add their time, which the time forecast leaves out.
 #ifndef FINECAP_PROBLEM_SIZE_H_
 #define FINECAP_PROBLEM_SIZE_H_
 
@@ -38,7 +42,7 @@ struct ProblemSize {
   // Forecast peak resident memory of a run refining frames like this one, MB.
   double peak_memory_mb = 0.0;
   // Forecast time of one frame, seconds, on the machine the constants were measured on (2 cores);
-  // a rough figure, good to a factor of about 2.
+  // a rough figure, good to a factor of about 3.
   double seconds_per_frame = 0.0;
 };
 
