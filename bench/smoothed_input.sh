@@ -14,9 +14,10 @@
 # Environment: FRAMES (default 10), ITERATIONS (synth.smoothing.iterations, default the
 # preset's), KEEP=1 to keep the capture and the run (printed), FINECAP (default build/finecap).
 #
-# Prints one "name: value" a line: per frame input_rms_mm, refined_rms_mm, recovered_percent
-# (1 - refined / input, over every refined vertex), then the same pooled over the sequence, and
-# the seconds taken by synth, refine and eval.
+# Prints a line per frame, "frame <name>: input_rms_mm A refined_rms_mm B recovered_percent C"
+# (RMS of k - k_true over every refined vertex; C = 100 (1 - B / A)), then one "name: value" a
+# line: the same pooled over the sequence (pooled_input_rms_mm, pooled_refined_rms_mm,
+# pooled_recovered_percent) and the seconds taken by synth, refine and eval.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 meshes=${1:-}
@@ -49,7 +50,8 @@ start=$(date +%s.%N)
 refine_seconds=$(seconds_since "$start")
 # Only the figures against the truth are printed: the optical flow is left out to save time.
 start=$(date +%s.%N)
-"$finecap" eval --capture "$work/capture" --out "$work/run" --set eval.flow=none >/dev/null
+"$finecap" eval --capture "$work/capture" --out "$work/run" --set eval.flow=none >/dev/null \
+  2>"$work/eval.log"
 eval_seconds=$(seconds_since "$start")
 
 metrics="$work/run/eval/metrics.json"

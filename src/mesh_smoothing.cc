@@ -25,16 +25,11 @@ double CotangentAt(const Eigen::Vector3d& apex, const Eigen::Vector3d& a,
   return u.dot(v) / sine;
 }
 
-// The row-normalised weights of the Laplacian: row i holds w_ij / sum_j w_ij over the neighbours
-// j of vertex i, so that (vertices * weights^T).col(i) is the weighted mean of i's neighbours.
-// Edge weights are half the sum of the cotangents opposite the edge (one per triangle on it),
+// Per edge, half the sum of the cotangents of the angles opposite it (one per triangle on it),
 // clamped at zero: a negative weight (an edge that is not locally Delaunay) would push a vertex
-// away from its neighbour. A vertex whose weights sum to zero gets uniform weights.
-Eigen::SparseMatrix<double, Eigen::RowMajor> NeighbourWeights(const Mesh& mesh) {
-  const MeshEdges edges = BuildMeshEdges(mesh.faces);
-  const int n = mesh.num_vertices();
-  std::vector<double> edge_weight(edges.num_edges(), 0.0);
-  Eigen::VectorXd sums = Eigen::VectorXd::Zero(n);
+// away from its neighbour.
+std::vector<double> CotangentEdgeWeights(const Mesh& mesh, const MeshEdges& edges) {
+  std::vector<double> weights(edges.num_edges(), 0.0);
   for (int e = 0; e < edges.num_edges(); ++e) {
     double weight = 0.0;
     for (int k = edges.side_offsets[e]; k < edges.side_offsets[e + 1]; ++k) {
@@ -46,24 +41,33 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> NeighbourWeights(const Mesh& mesh) 
       weight +=
           0.5 * CotangentAt(mesh.vertices.col(apex), mesh.vertices.col(a), mesh.vertices.col(b));
     }
-    edge_weight[e] = std::max(weight, 0.0);
-    sums(edges.vertices(0, e)) += edge_weight[e];
-    sums(edges.vertices(1, e)) += edge_weight[e];
+    weights[e] = std::max(weight, 0.0);
   }
-  Eigen::VectorXi degree = Eigen::VectorXi::Zero(n);
+  return weights;
+}
+
+// The row-normalised weights of the Laplacian: row i holds w_ij / sum_j w_ij over the neighbours
+// j of vertex i, so that (vertices * weights^T).col(i) is the weighted mean of i's neighbours. A
+// vertex whose cotangent weights sum to zero gets uniform weights.
+Eigen::SparseMatrix<double, Eigen::RowMajor> NeighbourWeights(const Mesh& mesh) {
+  const MeshEdges edges = BuildMeshEdges(mesh.faces);
+  const std::vector<double> edge_weights = CotangentEdgeWeights(mesh, edges);
+  const int n = mesh.num_vertices();
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd degrees = Eigen::VectorXd::Zero(n);
   for (int e = 0; e < edges.num_edges(); ++e) {
-    ++degree(edges.vertices(0, e));
-    ++degree(edges.vertices(1, e));
+    for (int end = 0; end < 2; ++end) {
+      sums(edges.vertices(end, e)) += edge_weights[e];
+      degrees(edges.vertices(end, e)) += 1.0;
+    }
   }
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(2 * edges.num_edges());
   for (int e = 0; e < edges.num_edges(); ++e) {
-    const int ends[2] = {edges.vertices(0, e), edges.vertices(1, e)};
-    for (int side = 0; side < 2; ++side) {
-      const int row = ends[side];
-      const double weight =
-          sums(row) > 0.0 ? edge_weight[e] / sums(row) : 1.0 / static_cast<double>(degree(row));
-      entries.emplace_back(row, ends[1 - side], weight);
+    for (int end = 0; end < 2; ++end) {
+      const int row = edges.vertices(end, e);
+      const double weight = sums(row) > 0.0 ? edge_weights[e] / sums(row) : 1.0 / degrees(row);
+      entries.emplace_back(row, edges.vertices(1 - end, e), weight);
     }
   }
   Eigen::SparseMatrix<double, Eigen::RowMajor> weights(n, n);

@@ -46,10 +46,11 @@ struct TaubinSmoothingOptions {
 // normal: the Laplacian of an unevenly sampled surface also points along the surface, and
 // following it would slide the vertices over the surface (tangential drift), so that a vertex
 // would no longer stand for the same point of the surface; the normal part alone removes bumps
-// and leaves the sampling in place. Cotangent weights (clamped at zero, uniform weights for a
-// vertex whose weights sum to zero) make the Laplacian of a flat region zero however it is
-// triangulated. Boundary vertices are smoothed like the others; vertices in no triangle keep
-// their place. Throws Error (through options.Check("smoothing")) on invalid options.
+// and leaves the sampling in place. Cotangent weights (those of the Laplace-Beltrami operator;
+// clamped at zero, uniform for a vertex whose weights sum to zero) make the smoothing follow the
+// surface's shape in metres rather than how it happens to be triangulated. Boundary vertices are
+// smoothed like the others; vertices in no triangle keep their place. Throws Error (through
+// options.Check("smoothing")) on invalid options.
 Eigen::Matrix3Xd TaubinSmooth(const Mesh& mesh, const TaubinSmoothingOptions& options);
 
 }  // namespace finecap
