@@ -8,6 +8,16 @@
 
 namespace finecap {
 
+PairOptions EnergyPairOptions(const EnergyOptions& options) {
+  PairOptions pair_options;
+  pair_options.k_max = options.k_max;
+  pair_options.reach_sigmas = options.reach_sigmas;
+  // The paper's similarity weighs pairs by colour agreement; the colour residual compares
+  // colours itself and needs every pair in reach.
+  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  return pair_options;
+}
+
 namespace {
 
 const EnergyOptions& Checked(const EnergyOptions& options) {
@@ -18,12 +28,7 @@ const EnergyOptions& Checked(const EnergyOptions& options) {
 std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
                                    const std::vector<CameraInput>& cameras,
                                    const EnergyOptions& options) {
-  PairOptions pair_options;
-  pair_options.k_max = options.k_max;
-  pair_options.reach_sigmas = options.reach_sigmas;
-  // The paper's similarity weighs pairs by colour agreement; the colour residual compares
-  // colours itself and needs every pair in reach.
-  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  const PairOptions pair_options = EnergyPairOptions(options);
   std::vector<EnergyView> views(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     Require(cameras[c].visible.size() == static_cast<size_t>(surface.size()),
@@ -61,8 +66,8 @@ std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
   if (options.similarity == "paper") return std::make_unique<PaperSimilarity>(surface, views, form);
   if (options.similarity == "consensus") {
     return std::make_unique<ConsensusSimilarity>(
-        surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form, options.k_max,
-        options.consensus);
+        surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form,
+        options.k_max, options.consensus);
   }
   return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
 }

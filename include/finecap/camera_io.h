@@ -54,8 +54,10 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
 
 // The rig of a capture folder: cameras.yaml if present, else intri.yml + extri.yml, else a COLMAP
 // text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or `capture_dir` itself (the first
-// holding a cameras.txt). Throws Error naming the folder if none is found.
-std::vector<Camera> ReadRig(const std::string& capture_dir);
+// holding a cameras.txt). Throws Error naming the folder if none is found. When `source` is given
+// it receives what the rig was read from, e.g. "cameras.yaml", "intri.yml + extri.yml" or
+// "COLMAP text model in sparse/0".
+std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source = nullptr);
 
 }  // namespace finecap
 
