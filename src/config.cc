@@ -131,6 +131,10 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
   schema->AddBool("energy.consensus.gain_per_channel", &energy->consensus.gain_per_channel,
                   "Consensus similarity: normalise each camera's gain per channel (white "
                   "balance) instead of once for all channels (exposure).");
+  schema->AddDouble("energy.consensus.robust_fraction", &energy->consensus.robust_fraction,
+                    "Consensus similarity: scale of Cauchy's loss on each patch's disagreement, "
+                    "as a fraction of that of unrelated patches; 0: plain least squares.",
+                    0.0, 100.0);
   schema->AddChoice("energy.overlap", &energy->overlap,
                     "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
                     "patch (image Gaussians as the squares they stand for).",

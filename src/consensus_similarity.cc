@@ -59,6 +59,36 @@ void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::V
   }
 }
 
+// Scales a block's residuals r (and their derivatives dr/dk, when given) so that their sum of
+// squares becomes rho(|r|^2) = c2 log(1 + |r|^2 / c2), Cauchy's loss: a block that disagrees far
+// more than c2 stops pulling its Gaussian harder, and the regulariser carries its neighbours'
+// displacement into it. r' = alpha r with alpha = sqrt(rho(s) / s), s = |r|^2, and
+// dr'/dk = alpha dr/dk + r (d alpha / ds) 2 <r, dr/dk>.
+void Robustify(double c2, int num_residuals, double* residuals, double* jacobian) {
+  if (c2 <= 0.0) return;
+  double s = 0.0, ds = 0.0;
+  for (int r = 0; r < num_residuals; ++r) {
+    s += residuals[r] * residuals[r];
+    if (jacobian != nullptr) ds += 2.0 * residuals[r] * jacobian[r];
+  }
+  const double u = s / c2;
+  // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
+  double alpha, dalpha_ds;
+  if (u < 1e-6) {
+    alpha = 1.0 - 0.25 * u;
+    dalpha_ds = -0.25 / c2;
+  } else {
+    const double rho = c2 * std::log1p(u);
+    const double drho = 1.0 / (1.0 + u);
+    alpha = std::sqrt(rho / s);
+    dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
+  }
+  for (int r = 0; r < num_residuals; ++r) {
+    if (jacobian != nullptr) jacobian[r] = alpha * jacobian[r] + residuals[r] * dalpha_ds * ds;
+    residuals[r] *= alpha;
+  }
+}
+
 }  // namespace
 
 ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
@@ -217,6 +247,12 @@ void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* ja
       const Eigen::Vector3d d = weight.cwiseProduct(dz[a][m] - mean_derivative);
       std::copy_n(d.data(), 3, jacobian + (a * n + m) * 3);
     }
+  }
+  if (options_.robust_fraction > 0.0) {
+    // The level of disagreement of unrelated patches: each normalised channel has unit
+    // variance, so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
+    const double unrelated = 3.0 * n * (num_cameras - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
+    Robustify(options_.robust_fraction * unrelated, blocks_[b].num_residuals, residuals, jacobian);
   }
 }
 

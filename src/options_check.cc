@@ -47,6 +47,7 @@ void ConsensusOptions::Check() const {
   Require(min_cameras >= 2, "energy.consensus.min_cameras", "must be at least 2");
   Require(passes >= 1, "energy.consensus.passes", "must be at least 1");
   Require(patch_rings >= 1, "energy.consensus.patch_rings", "must be at least 1");
+  Require(robust_fraction >= 0.0, "energy.consensus.robust_fraction", "must be non-negative");
 }
 
 void SolverOptions::Check() const {

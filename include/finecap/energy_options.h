@@ -24,6 +24,9 @@ struct ConsensusOptions {
   // Whether each camera's gain is normalised per channel (white balance) or once for all three
   // (exposure; its offsets stay per channel). Default true.
   bool gain_per_channel = true;
+  // Cauchy's robust loss on each patch's squared disagreement, with its scale this fraction of
+  // the disagreement of unrelated patches; 0 turns it off (plain least squares).
+  double robust_fraction = 0.0;
 
   void Check() const;
 };
