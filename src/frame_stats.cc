@@ -74,6 +74,10 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
        << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
+       << ", \"heldout_ncc_input\": " << JsonNumber(s.heldout_ncc_input)
+       << ", \"heldout_ncc_refined\": " << JsonNumber(s.heldout_ncc_refined)
+       << ", \"heldout_mad_input\": " << JsonNumber(s.heldout_mad_input)
+       << ", \"heldout_mad_refined\": " << JsonNumber(s.heldout_mad_refined)
        << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << ", \"skipped_cameras\": [";
   for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
     json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
@@ -107,6 +111,10 @@ struct StatsFields {
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
       {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm},
+      {"heldout_ncc_input", &FrameStats::heldout_ncc_input},
+      {"heldout_ncc_refined", &FrameStats::heldout_ncc_refined},
+      {"heldout_mad_input", &FrameStats::heldout_mad_input},
+      {"heldout_mad_refined", &FrameStats::heldout_mad_refined},
       {"peak_rss_mb", &FrameStats::peak_rss_mb}};
   std::vector<std::pair<const char*, int FrameStats::*>> ints = {
       {"iterations", &FrameStats::iterations},

@@ -103,8 +103,10 @@ VariantSummary MeasureVariant(const Variant& variant, const FrameRange& frames, 
     records.push_back(ReadFrameStats(out + "/frames/" + name + ".json"));
     const Eigen::VectorXd k =
         internal::ReadDisplacement(out + "/k/" + name + ".txt", model.num_fine_vertices());
-    paper_similarity.push_back(PaperSimilarityAtResult(
-        model, colors, internal::ReadFrameInput(capture, frame), config, records.back(), k));
+    FrameInput input = internal::ReadFrameInput(capture, frame);
+    internal::TakeHeldOutViews(config, &input);  // The energy as the variant's refine saw it.
+    paper_similarity.push_back(
+        PaperSimilarityAtResult(model, colors, input, config, records.back(), k));
   }
   return SummarizeVariant(variant.spec.name, records, paper_similarity);
 }

@@ -9,6 +9,7 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
+#include "finecap/heldout_score.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
 #include "finecap/scene_scale.h"
@@ -78,6 +79,28 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
       1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
 }
 
+// The held-out score of the frame's input and of its result (as solved), into `stats`; a result
+// whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
+// replaced by the input.
+void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const FrameInput& input,
+                         const std::vector<View>& held_out, FrameResult* result,
+                         FrameStats* stats) {
+  if (held_out.empty()) return;
+  const Mesh fine_input = model.Subdivide(input.coarse);
+  const HeldOutScore score = ScoreHeldOutViews(
+      internal::ViewsOf(input), held_out, {&fine_input, &result->refined}, config.validation.score);
+  stats->heldout_ncc_input = score.mean[0].ncc;
+  stats->heldout_ncc_refined = score.mean[1].ncc;
+  stats->heldout_mad_input = score.mean[0].mad;
+  stats->heldout_mad_refined = score.mean[1].mad;
+  if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
+  result->worse = stats->worse = true;
+  if (config.refine.keep_input_if_worse && !result->kept_input) {
+    KeepInputSurface(fine_input, result);
+    stats->kept_input = true;
+  }
+}
+
 void PrintProblemSize(const Capture& capture, const SequenceModel& model, int frames) {
   const Camera& camera = capture.cameras().front();
   const double pixels = double(camera.width) * camera.height * capture.num_cameras();
@@ -132,8 +155,9 @@ int RunRefine(const Config& config) {
     }
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> skipped;
-    const FrameInput input =
+    FrameInput input =
         internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
+    const std::vector<View> held_out = internal::TakeHeldOutViews(config, &input);
     const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
     FrameResult result = warm_start.size() > 0
                              ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
@@ -146,6 +170,7 @@ int RunRefine(const Config& config) {
 
     FrameStats stats = MakeFrameStats(name, config.refine, result);
     stats.skipped_cameras = skipped;
+    ScoreInHeldOutViews(config, model, input, held_out, &result, &stats);
     AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
     WriteMesh(files.mesh, result.refined, {result.normals, {}, quality},
@@ -161,7 +186,11 @@ int RunRefine(const Config& config) {
     std::ostringstream detail;
     detail.precision(3);
     detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
-           << " iterations" << (stats.worse ? ", WORSE" : "");
+           << " iterations";
+    if (std::isfinite(stats.heldout_ncc_input)) {
+      detail << ", held-out NCC " << stats.heldout_ncc_input << " -> " << stats.heldout_ncc_refined;
+    }
+    detail << (stats.worse ? ", WORSE" : "") << (stats.kept_input ? " (input kept)" : "");
     if (std::isfinite(stats.rms_refined_mm)) {
       detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
       sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
