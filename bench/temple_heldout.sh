@@ -18,6 +18,7 @@ if [ ! -f "$capture/cameras.yaml" ]; then
 fi
 work=${OUT:-$(mktemp -d)}
 [ -n "${OUT:-}" ] || trap 'rm -rf "$work"' EXIT
+mkdir -p "$work"
 rm -rf "$work/run"
 
 [ -x build/finecap ] || bash scripts/build.sh >/dev/null

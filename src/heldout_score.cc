@@ -161,6 +161,17 @@ cv::Mat NccMap(const HeldOutWindows& windows, const cv::Mat& warped_grey, const 
   return ncc;
 }
 
+// 255 where a CV_32F map is finite (OpenCV's comparisons do not single out NaN).
+cv::Mat FiniteMask(const cv::Mat& values) {
+  cv::Mat mask(values.size(), CV_8U);
+  for (int y = 0; y < values.rows; ++y) {
+    for (int x = 0; x < values.cols; ++x) {
+      mask.at<unsigned char>(y, x) = std::isfinite(values.at<float>(y, x)) ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
 // Mean of the finite values of a CV_32F map and their count.
 std::pair<double, long> FiniteMean(const cv::Mat& values) {
   double sum = 0.0;
@@ -262,7 +273,7 @@ HeldOutViewScore ScoreView(const View& held_out, const std::vector<View>& traini
       mad[s].push_back(MeanAbsoluteDifference(grey, warps[s].grey, common, &common_count));
       if (s == 0) score.common_pixels += common_count;
       if (maps != nullptr) {
-        cv::Mat finite = map == map;  // NaN compares unequal to itself.
+        const cv::Mat finite = FiniteMask(map);
         cv::Mat values = map.clone();
         values.setTo(0.0f, ~finite);
         if (ncc_sum[s].empty()) {

@@ -3,6 +3,7 @@
 // the temple's height. Refine with the four views of configs/temple.yaml held out, then eval: every
 // held-out view gets finite scores, from the photos alone (the capture has no ground truth).
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -21,7 +22,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char kTemple[] = FINECAP_SOURCE_DIR "/../shared/captures/middlebury_temple";
+// ../shared/captures next to the repository (as CI has it), or the folder FINECAP_CAPTURES names
+// (a worktree elsewhere).
+std::string TempleDir() {
+  const char* captures = std::getenv("FINECAP_CAPTURES");
+  return (captures != nullptr && *captures != '\0' ? std::string(captures)
+                                                   : FINECAP_SOURCE_DIR "/../shared/captures") +
+         "/middlebury_temple";
+}
 
 // The temple with a mask.txt of the coarse vertices whose height (world y) lies in the middle
 // `share` of the mesh's: the capture's own files linked, not copied.
@@ -29,7 +37,7 @@ std::string ReducedTemple(const std::string& root, double share) {
   const std::string dir = root + "/temple";
   fs::create_directories(dir);
   for (const char* entry : {"cameras.yaml", "images", "meshes"}) {
-    fs::create_symlink(fs::absolute(fs::path(kTemple) / entry), fs::path(dir) / entry);
+    fs::create_symlink(fs::absolute(fs::path(TempleDir()) / entry), fs::path(dir) / entry);
   }
   const Mesh mesh = Capture::Open(dir).ReadCoarseMesh(0);
   const double low = mesh.vertices.row(1).minCoeff(), high = mesh.vertices.row(1).maxCoeff();
@@ -43,9 +51,10 @@ std::string ReducedTemple(const std::string& root, double share) {
 }
 
 TEST(TempleTest, HeldOutViewsAreScoredOnRealPhotos) {
-  if (!fs::exists(fs::path(kTemple) / "cameras.yaml")) {
-    GTEST_SKIP() << "the Middlebury temple capture is not at " << kTemple
-                 << " (../shared/captures/middlebury_temple next to the repository)";
+  if (!fs::exists(fs::path(TempleDir()) / "cameras.yaml")) {
+    GTEST_SKIP() << "the Middlebury temple capture is not at " << TempleDir()
+                 << " (../shared/captures/middlebury_temple next to the repository, or "
+                    "$FINECAP_CAPTURES/middlebury_temple)";
   }
   const std::string root = testing_util::MakeTempDir("temple");
   Config config = LoadConfig(FINECAP_SOURCE_DIR "/configs/temple.yaml",

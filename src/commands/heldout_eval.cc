@@ -20,7 +20,13 @@ cv::Mat NccPicture(const cv::Mat& ncc, const cv::Mat& image) {
   cv::applyColorMap(scaled, picture, cv::COLORMAP_TURBO);
   cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   cv::cvtColor(grey / 2, grey, cv::COLOR_GRAY2BGR);
-  grey.copyTo(picture, ncc != ncc);  // NaN: not scored.
+  cv::Mat scored(ncc.size(), CV_8U);
+  for (int y = 0; y < ncc.rows; ++y) {
+    for (int x = 0; x < ncc.cols; ++x) {
+      scored.at<unsigned char>(y, x) = std::isfinite(ncc.at<float>(y, x)) ? 255 : 0;
+    }
+  }
+  grey.copyTo(picture, scored == 0);
   return picture;
 }
 
