@@ -17,7 +17,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-void CheckView(const View& view, const std::string& role) {
+void CheckView(const CalibratedImage& view, const std::string& role) {
   const std::string where = role + " camera " + view.camera.name;
   Require(view.image.type() == CV_8UC3 && view.image.cols == view.camera.width &&
               view.image.rows == view.camera.height,
@@ -65,9 +65,10 @@ struct Warp {
   cv::Mat valid;  // CV_8U, 255 where the surface point is seen by the training view.
 };
 
-Warp WarpThroughSurface(const Camera& target, const DepthMap& target_depth, const View& source,
-                        const cv::Mat& source_grey, const DepthMap& source_depth,
-                        const HeldOutOptions& options, bool with_color) {
+Warp WarpThroughSurface(const Camera& target, const DepthMap& target_depth,
+                        const CalibratedImage& source, const cv::Mat& source_grey,
+                        const DepthMap& source_depth, const HeldOutOptions& options,
+                        bool with_color) {
   Warp warp;
   warp.grey = cv::Mat::zeros(target.height, target.width, CV_32F);
   warp.valid = cv::Mat::zeros(target.height, target.width, CV_8U);
@@ -213,7 +214,8 @@ double FiniteAverage(const std::vector<double>& values) {
 // Depth maps of the training views, rendered once per (view, surface) when first needed.
 class TrainingDepths {
  public:
-  TrainingDepths(const std::vector<View>& training, const std::vector<const Mesh*>& surfaces)
+  TrainingDepths(const std::vector<CalibratedImage>& training,
+                 const std::vector<const Mesh*>& surfaces)
       : training_(training), surfaces_(surfaces) {}
 
   const DepthMap& Get(int view, int surface) {
@@ -223,80 +225,122 @@ class TrainingDepths {
   }
 
  private:
-  const std::vector<View>& training_;
+  const std::vector<CalibratedImage>& training_;
   const std::vector<const Mesh*>& surfaces_;
   std::map<std::pair<int, int>, DepthMap> depths_;
 };
 
+// The mean of NCC maps over training views, per pixel where any scored it (NaN elsewhere).
+class NccMapMean {
+ public:
+  void Add(const cv::Mat& map) {
+    if (sum_.empty()) {
+      sum_ = cv::Mat::zeros(map.size(), CV_32F);
+      count_ = cv::Mat::zeros(map.size(), CV_32F);
+    }
+    const cv::Mat finite = FiniteMask(map);
+    cv::Mat values = map.clone(), ones;
+    values.setTo(0.0f, ~finite);
+    finite.convertTo(ones, CV_32F, 1.0 / 255.0);
+    sum_ += values;
+    count_ += ones;
+  }
+
+  cv::Mat Mean(const cv::Size& size) const {
+    cv::Mat mean(size, CV_32F, cv::Scalar(kNaN));
+    if (sum_.empty()) return mean;
+    const cv::Mat quotient = sum_ / cv::max(count_, 1.0f);
+    quotient.copyTo(mean, count_ > 0.5f);
+    return mean;
+  }
+
+ private:
+  cv::Mat sum_, count_;
+};
+
+// The surfaces compared in one held-out view with one training view.
+struct PairScore {
+  std::vector<SurfaceScore> surfaces;
+  long ncc_pixels = 0, common_pixels = 0;
+  std::vector<cv::Mat> ncc_maps;  // Per surface.
+  std::vector<cv::Mat> colors;    // Per surface, when asked for.
+};
+
+// What one held-out view shows, prepared once for all its training views.
+struct HeldOutTarget {
+  const CalibratedImage* view;
+  cv::Mat grey;
+  std::vector<DepthMap> depths;  // Per surface.
+  cv::Mat covered;               // Pixels every surface covers.
+};
+
+PairScore ScorePair(const HeldOutTarget& target, const CalibratedImage& training,
+                    const cv::Mat& training_grey, int training_index, int num_surfaces,
+                    const HeldOutOptions& options, bool with_color,
+                    TrainingDepths* training_depths) {
+  std::vector<Warp> warps;
+  cv::Mat common = target.covered.clone();
+  for (int s = 0; s < num_surfaces; ++s) {
+    warps.push_back(WarpThroughSurface(target.view->camera, target.depths[s], training,
+                                       training_grey, training_depths->Get(training_index, s),
+                                       options, with_color));
+    common &= warps.back().valid;
+  }
+  const HeldOutWindows windows = MakeHeldOutWindows(target.grey, common, options);
+  PairScore pair;
+  for (int s = 0; s < num_surfaces; ++s) {
+    pair.ncc_maps.push_back(NccMap(windows, warps[s].grey, common, options.window));
+    const auto [ncc, ncc_pixels] = FiniteMean(pair.ncc_maps.back());
+    const double mad =
+        MeanAbsoluteDifference(target.grey, warps[s].grey, common, &pair.common_pixels);
+    pair.surfaces.push_back({ncc, mad});
+    pair.ncc_pixels = ncc_pixels;  // The same pixels for every surface.
+    if (with_color) pair.colors.push_back(warps[s].color);
+  }
+  return pair;
+}
+
 // Scores one held-out view; fills `maps` when given.
-HeldOutViewScore ScoreView(const View& held_out, const std::vector<View>& training,
+HeldOutViewScore ScoreView(const CalibratedImage& held_out,
+                           const std::vector<CalibratedImage>& training,
                            const std::vector<cv::Mat>& training_grey,
                            const std::vector<const Mesh*>& surfaces, const HeldOutOptions& options,
                            TrainingDepths* training_depths, HeldOutViewMaps* maps) {
-  const size_t num_surfaces = surfaces.size();
+  const int num_surfaces = static_cast<int>(surfaces.size());
+  HeldOutTarget target{&held_out,
+                       GreyLevels(held_out.image),
+                       {},
+                       cv::Mat(held_out.image.size(), CV_8U, cv::Scalar(255))};
+  for (const Mesh* surface : surfaces) {
+    target.depths.push_back(RenderDepth(held_out.camera, *surface));
+    target.covered &= target.depths.back().triangle_ids >= 0;
+  }
+  std::vector<Camera> training_cameras;
+  for (const CalibratedImage& view : training) training_cameras.push_back(view.camera);
   HeldOutViewScore score;
   score.camera = held_out.camera.name;
-  std::vector<Camera> training_cameras;
-  for (const View& view : training) training_cameras.push_back(view.camera);
-  const std::vector<int> nearest =
-      NearestCameras(held_out.camera, training_cameras, options.neighbours);
-  for (int t : nearest) score.training.push_back(training[t].camera.name);
-
-  std::vector<DepthMap> depths;
-  cv::Mat covered(held_out.camera.height, held_out.camera.width, CV_8U, cv::Scalar(255));
-  for (const Mesh* surface : surfaces) {
-    depths.push_back(RenderDepth(held_out.camera, *surface));
-    covered &= depths.back().triangle_ids >= 0;
-  }
-  const cv::Mat grey = GreyLevels(held_out.image);
   std::vector<std::vector<double>> ncc(num_surfaces), mad(num_surfaces);
-  std::vector<cv::Mat> ncc_sum(num_surfaces), ncc_count(num_surfaces);
-  if (maps != nullptr) maps->warped.assign(num_surfaces, cv::Mat());
-  for (size_t i = 0; i < nearest.size(); ++i) {
-    const int t = nearest[i];
-    const bool with_color = maps != nullptr && i == 0;
-    std::vector<Warp> warps;
-    cv::Mat common = covered.clone();
-    for (size_t s = 0; s < num_surfaces; ++s) {
-      warps.push_back(WarpThroughSurface(held_out.camera, depths[s], training[t], training_grey[t],
-                                         training_depths->Get(t, s), options, with_color));
-      common &= warps.back().valid;
-      if (with_color) maps->warped[s] = warps.back().color;
+  std::vector<NccMapMean> map_means(num_surfaces);
+  for (int t : NearestCameras(held_out.camera, training_cameras, options.neighbours)) {
+    const bool with_color = maps != nullptr && score.training.empty();
+    const PairScore pair = ScorePair(target, training[t], training_grey[t], t, num_surfaces,
+                                     options, with_color, training_depths);
+    score.training.push_back(training[t].camera.name);
+    score.ncc_pixels += pair.ncc_pixels;
+    score.common_pixels += pair.common_pixels;
+    for (int s = 0; s < num_surfaces; ++s) {
+      ncc[s].push_back(pair.surfaces[s].ncc);
+      mad[s].push_back(pair.surfaces[s].mad);
+      if (maps != nullptr) map_means[s].Add(pair.ncc_maps[s]);
     }
-    const HeldOutWindows windows = MakeHeldOutWindows(grey, common, options);
-    for (size_t s = 0; s < num_surfaces; ++s) {
-      const cv::Mat map = NccMap(windows, warps[s].grey, common, options.window);
-      const auto [mean, count] = FiniteMean(map);
-      ncc[s].push_back(mean);
-      if (s == 0) score.ncc_pixels += count;
-      long common_count = 0;
-      mad[s].push_back(MeanAbsoluteDifference(grey, warps[s].grey, common, &common_count));
-      if (s == 0) score.common_pixels += common_count;
-      if (maps != nullptr) {
-        const cv::Mat finite = FiniteMask(map);
-        cv::Mat values = map.clone();
-        values.setTo(0.0f, ~finite);
-        if (ncc_sum[s].empty()) {
-          ncc_sum[s] = cv::Mat::zeros(map.size(), CV_32F);
-          ncc_count[s] = cv::Mat::zeros(map.size(), CV_32F);
-        }
-        ncc_sum[s] += values;
-        cv::Mat ones;
-        finite.convertTo(ones, CV_32F, 1.0 / 255.0);
-        ncc_count[s] += ones;
-      }
-    }
+    if (with_color) maps->warped = pair.colors;
   }
-  for (size_t s = 0; s < num_surfaces; ++s) {
+  for (int s = 0; s < num_surfaces; ++s) {
     score.surfaces.push_back({FiniteAverage(ncc[s]), FiniteAverage(mad[s])});
-    if (maps == nullptr) continue;
-    cv::Mat mean(covered.size(), CV_32F, cv::Scalar(kNaN));
-    if (!ncc_sum[s].empty()) {
-      cv::Mat quotient = ncc_sum[s] / cv::max(ncc_count[s], 1.0f);
-      quotient.copyTo(mean, ncc_count[s] > 0.5f);
-    }
-    maps->ncc.push_back(mean);
-    if (maps->warped[s].empty()) maps->warped[s] = cv::Mat::zeros(covered.size(), CV_8UC3);
+    if (maps != nullptr) maps->ncc.push_back(map_means[s].Mean(held_out.image.size()));
+  }
+  if (maps != nullptr && maps->warped.empty()) {
+    maps->warped.assign(num_surfaces, cv::Mat::zeros(held_out.image.size(), CV_8UC3));
   }
   return score;
 }
@@ -316,16 +360,17 @@ std::vector<int> NearestCameras(const Camera& target, const std::vector<Camera>&
   return order;
 }
 
-HeldOutScore ScoreHeldOutViews(const std::vector<View>& training, const std::vector<View>& held_out,
+HeldOutScore ScoreHeldOutViews(const std::vector<CalibratedImage>& training,
+                               const std::vector<CalibratedImage>& held_out,
                                const std::vector<const Mesh*>& surfaces,
                                const HeldOutOptions& options, std::vector<HeldOutViewMaps>* maps) {
   options.Check();
   Require(!training.empty(), "held-out score", "no training view to warp in");
   Require(!surfaces.empty(), "held-out score", "no surface to score");
-  for (const View& view : training) CheckView(view, "training");
-  for (const View& view : held_out) CheckView(view, "held-out");
+  for (const CalibratedImage& view : training) CheckView(view, "training");
+  for (const CalibratedImage& view : held_out) CheckView(view, "held-out");
   std::vector<cv::Mat> training_grey;
-  for (const View& view : training) training_grey.push_back(GreyLevels(view.image));
+  for (const CalibratedImage& view : training) training_grey.push_back(GreyLevels(view.image));
   TrainingDepths training_depths(training, surfaces);
   HeldOutScore score;
   if (maps != nullptr) maps->assign(held_out.size(), HeldOutViewMaps());

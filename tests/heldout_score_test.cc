@@ -47,9 +47,9 @@ SynthOptions FoldedSkirtOptions() {
 TEST(HeldOutScoreTest, TheTrueSurfaceScoresHigherThanTheCoarseOne) {
   const SyntheticCapture capture(FoldedSkirtOptions());
   const SyntheticFrame frame = capture.Frame(0);
-  std::vector<View> training, held_out;
+  std::vector<CalibratedImage> training, held_out;
   for (int c = 0; c < 8; ++c) {
-    View view{capture.true_cameras()[c], capture.Image(frame, 0, c)};
+    CalibratedImage view{capture.true_cameras()[c], capture.Image(frame, 0, c)};
     (c % 4 == 0 ? held_out : training).push_back(view);
   }
   const HeldOutScore score =
@@ -70,19 +70,19 @@ TEST(HeldOutScoreTest, TheTrueSurfaceScoresHigherThanTheCoarseOne) {
 TEST(HeldOutScoreTest, OccludedPointsAndFlatWindowsAreNotScored) {
   const SyntheticCapture capture(FoldedSkirtOptions());
   const SyntheticFrame frame = capture.Frame(0);
-  const View held_out{capture.true_cameras()[0], capture.Image(frame, 0, 0)};
+  const CalibratedImage held_out{capture.true_cameras()[0], capture.Image(frame, 0, 0)};
   // The opposite camera sees the skirt's far side only: every point the held-out view sees on
   // the near side is hidden from it, so (almost) nothing is warped in.
-  const View opposite{capture.true_cameras()[4], capture.Image(frame, 0, 4)};
+  const CalibratedImage opposite{capture.true_cameras()[4], capture.Image(frame, 0, 4)};
   HeldOutOptions options;
   options.neighbours = 1;
   const HeldOutScore hidden = ScoreHeldOutViews({opposite}, {held_out}, {&frame.truth}, options);
-  const View neighbour{capture.true_cameras()[1], capture.Image(frame, 0, 1)};
+  const CalibratedImage neighbour{capture.true_cameras()[1], capture.Image(frame, 0, 1)};
   const HeldOutScore seen = ScoreHeldOutViews({neighbour}, {held_out}, {&frame.truth}, options);
   // Through the open hem the far camera sees a little of the inside: a small share at most.
   EXPECT_LT(hidden.views[0].common_pixels, seen.views[0].common_pixels / 10);
   // A held-out image without any structure has no window to correlate.
-  View flat = held_out;
+  CalibratedImage flat = held_out;
   flat.image = cv::Mat(held_out.image.size(), CV_8UC3, cv::Scalar(90, 90, 90));
   const HeldOutScore none = ScoreHeldOutViews({neighbour}, {flat}, {&frame.truth}, options);
   EXPECT_EQ(none.views[0].ncc_pixels, 0);
@@ -105,8 +105,8 @@ TEST(HeldOutScoreTest, RefusesBadOptionsAndImages) {
   ExpectErrorMentions([&] { options.Check(); }, {"validation.window"});
   const SyntheticCapture capture(FoldedSkirtOptions());
   const SyntheticFrame frame = capture.Frame(0);
-  View view{capture.true_cameras()[0], capture.Image(frame, 0, 0)};
-  View small = view;
+  CalibratedImage view{capture.true_cameras()[0], capture.Image(frame, 0, 0)};
+  CalibratedImage small = view;
   small.image = cv::Mat(10, 10, CV_8UC3);
   ExpectErrorMentions([&] { ScoreHeldOutViews({small}, {view}, {&frame.truth}, HeldOutOptions()); },
                       {"camera " + view.camera.name, "size"});

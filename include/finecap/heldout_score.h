@@ -58,8 +58,8 @@ struct HeldOutOptions {
   void Check() const;
 };
 
-// One camera's view: a pinhole camera (distortion zero) and its 8-bit BGR image of its size.
-struct View {
+// One view: a pinhole camera (distortion zero) and its 8-bit BGR image of its size.
+struct CalibratedImage {
   Camera camera;
   cv::Mat image;
 };
@@ -97,7 +97,8 @@ struct HeldOutScore {
 // When `maps` is given it receives one HeldOutViewMaps per held-out view. Throws Error when
 // `training` or `surfaces` is empty, an image is not 8-bit BGR of its camera's size, or the options
 // are invalid.
-HeldOutScore ScoreHeldOutViews(const std::vector<View>& training, const std::vector<View>& held_out,
+HeldOutScore ScoreHeldOutViews(const std::vector<CalibratedImage>& training,
+                               const std::vector<CalibratedImage>& held_out,
                                const std::vector<const Mesh*>& surfaces,
                                const HeldOutOptions& options,
                                std::vector<HeldOutViewMaps>* maps = nullptr);

@@ -54,8 +54,8 @@ Capture OpenConfiguredCapture(const Config& config) {
   return capture;
 }
 
-std::vector<View> TakeHeldOutViews(const Config& config, FrameInput* input) {
-  std::vector<View> held_out;
+std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input) {
+  std::vector<CalibratedImage> held_out;
   FrameInput training;
   training.coarse = std::move(input->coarse);
   for (size_t c = 0; c < input->cameras.size(); ++c) {
@@ -72,8 +72,8 @@ std::vector<View> TakeHeldOutViews(const Config& config, FrameInput* input) {
   return held_out;
 }
 
-std::vector<View> ViewsOf(const FrameInput& input) {
-  std::vector<View> views;
+std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
+  std::vector<CalibratedImage> views;
   for (size_t c = 0; c < input.cameras.size(); ++c) {
     views.push_back({input.cameras[c], input.images[c]});
   }

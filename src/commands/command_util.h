@@ -23,10 +23,10 @@ Capture OpenConfiguredCapture(const Config& config);
 // Removes the held-out cameras (validation.cameras) and their images from `input` and returns
 // them, in the rig's order: what is left is all that refinement may see. Throws Error when no
 // other camera is left (the others' images could not be read).
-std::vector<View> TakeHeldOutViews(const Config& config, FrameInput* input);
+std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input);
 
-// The cameras and images of `input` as views for the held-out score.
-std::vector<View> ViewsOf(const FrameInput& input);
+// The cameras and images of `input`, for the held-out score.
+std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // The configured frames of `capture`; an Error when the range holds none of its frames.
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture);

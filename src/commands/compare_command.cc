@@ -37,8 +37,8 @@ std::vector<Variant> VariantConfigs(const Config& config) {
   return variants;
 }
 
-// Everything the reference colours depend on (ComputeSequenceColors): variants that agree on it
-// share one computation.
+// Everything the reference colours depend on (ComputeSequenceColors, and the held-out cameras it
+// must not see): variants that agree on it share one computation.
 std::string ReferenceColorRecipe(const Config& config) {
   const RefineOptions& refine = config.refine;
   std::ostringstream recipe;
@@ -49,6 +49,7 @@ std::string ReferenceColorRecipe(const Config& config) {
          << refine.image.split_threshold << " " << refine.visibility.depth_tolerance << " "
          << refine.visibility.max_view_angle_deg << " " << refine.visibility.border_margin << " "
          << refine.energy.overlap << " " << refine.energy.reach_sigmas;
+  for (const std::string& held_out : config.validation.cameras) recipe << "\n" << held_out;
   return recipe.str();
 }
 

@@ -1,5 +1,6 @@
-// finecap eval: a refined run measured against the capture's ground truth; pictures, plots,
-// metrics.json and report.html in output.dir/eval/.
+// finecap eval: a refined run measured against the capture's ground truth (when it has one), by
+// optical flow and in the held-out cameras; pictures, plots, metrics.json and report.html in
+// output.dir/eval/.
 #include <cmath>
 #include <filesystem>
 #include <iostream>

@@ -76,10 +76,11 @@ HeldOutFrame EvaluateHeldOutFrame(const Config& config, const std::string& frame
                                   FrameInput frame, const Mesh& input, const Mesh& refined,
                                   const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures) {
-  const std::vector<View> held_out = TakeHeldOutViews(config, &frame);
+  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config, &frame);
   std::vector<HeldOutViewMaps> maps;
-  HeldOutFrame result{frame_name, ScoreHeldOutViews(ViewsOf(frame), held_out, {&input, &refined},
-                                                    config.validation.score, &maps)};
+  HeldOutFrame result{frame_name,
+                      ScoreHeldOutViews(CalibratedImagesOf(frame), held_out, {&input, &refined},
+                                        config.validation.score, &maps)};
   for (size_t h = 0; h < held_out.size(); ++h) {
     const cv::Mat& image = held_out[h].image;
     const cv::Rect box = WarpedBox(maps[h], image.size());

@@ -83,12 +83,13 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
 // whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
 // replaced by the input.
 void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const FrameInput& input,
-                         const std::vector<View>& held_out, FrameResult* result,
+                         const std::vector<CalibratedImage>& held_out, FrameResult* result,
                          FrameStats* stats) {
   if (held_out.empty()) return;
   const Mesh fine_input = model.Subdivide(input.coarse);
-  const HeldOutScore score = ScoreHeldOutViews(
-      internal::ViewsOf(input), held_out, {&fine_input, &result->refined}, config.validation.score);
+  const HeldOutScore score =
+      ScoreHeldOutViews(internal::CalibratedImagesOf(input), held_out,
+                        {&fine_input, &result->refined}, config.validation.score);
   stats->heldout_ncc_input = score.mean[0].ncc;
   stats->heldout_ncc_refined = score.mean[1].ncc;
   stats->heldout_mad_input = score.mean[0].mad;
@@ -157,7 +158,7 @@ int RunRefine(const Config& config) {
     std::vector<std::string> skipped;
     FrameInput input =
         internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
-    const std::vector<View> held_out = internal::TakeHeldOutViews(config, &input);
+    const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
     const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
     FrameResult result = warm_start.size() > 0
                              ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
