@@ -66,6 +66,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"seconds_solve\": " << JsonNumber(s.seconds_solve)
        << ", \"seconds_evaluation\": " << JsonNumber(s.seconds_evaluation)
        << ", \"seconds_linear_solver\": " << JsonNumber(s.seconds_linear_solver)
+       << ", \"seconds_heldout\": " << JsonNumber(s.seconds_heldout)
        << ", \"surface_gaussians\": " << s.surface_gaussians
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
@@ -107,6 +108,7 @@ struct StatsFields {
       {"seconds_solve", &FrameStats::seconds_solve},
       {"seconds_evaluation", &FrameStats::seconds_evaluation},
       {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
+      {"seconds_heldout", &FrameStats::seconds_heldout},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},

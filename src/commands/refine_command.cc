@@ -86,6 +86,7 @@ void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const
                          const std::vector<CalibratedImage>& held_out, FrameResult* result,
                          FrameStats* stats) {
   if (held_out.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
   const Mesh fine_input = model.Subdivide(input.coarse);
   const HeldOutScore score =
       ScoreHeldOutViews(internal::CalibratedImagesOf(input), held_out,
@@ -94,6 +95,8 @@ void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const
   stats->heldout_ncc_refined = score.mean[1].ncc;
   stats->heldout_mad_input = score.mean[0].mad;
   stats->heldout_mad_refined = score.mean[1].mad;
+  stats->seconds_heldout =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
   result->worse = stats->worse = true;
   if (config.refine.keep_input_if_worse && !result->kept_input) {
