@@ -7,7 +7,8 @@
 #   bash bench/temple_heldout.sh            # CAPTURE=DIR for a copy elsewhere; OUT=DIR keeps the run
 #
 # Prints one "name: value" a line: per held-out view heldout_ncc_input/refined and
-# heldout_mad_input/refined, the same over all views, refine_seconds and refine_peak_mb (wall
+# heldout_mad_input/refined, the same over all views, refine_worse (the frame's flag),
+# heldout_score_seconds (the score's share of refine), refine_seconds and refine_peak_mb (wall
 # time and peak resident memory of the whole `finecap refine`, /usr/bin/time), and eval_seconds.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,14 +29,17 @@ start=$(date +%s.%N)
 build/finecap eval "${args[@]}" --set eval.flow=none >/dev/null
 end=$(date +%s.%N)
 
-python3 - "$work/run/eval/metrics.json" <<'PY'
+python3 - "$work/run/eval/metrics.json" "$work/run/frames/000000.json" <<'PY'
 import json, sys
 metrics = json.load(open(sys.argv[1]))
+record = json.load(open(sys.argv[2]))
 for view in metrics["frames"][0]["heldout"]["views"]:
     for key in ("ncc_input", "ncc_refined", "mad_input", "mad_refined"):
         print(f"{view['camera']}_heldout_{key}: {view[key]:.4f}")
 for key in ("ncc_input", "ncc_refined", "mad_input", "mad_refined"):
     print(f"heldout_{key}: {metrics['heldout_' + key]:.4f}")
+print(f"refine_worse: {str(record['worse']).lower()}")
+print(f"heldout_score_seconds: {record['seconds_heldout']:.2f}")
 PY
 read -r seconds kilobytes < "$work/refine.time"
 echo "refine_seconds: $seconds"
