@@ -1,5 +1,6 @@
-// finecap eval: a refined run measured against the capture's ground truth; pictures, plots,
-// metrics.json and report.html in output.dir/eval/.
+// finecap eval: a refined run measured against the capture's ground truth (when it has one), by
+// optical flow and in the held-out cameras; pictures, plots, metrics.json and report.html in
+// output.dir/eval/.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands/command_util.h"
+#include "commands/heldout_eval.h"
 #include "finecap/atomic_file.h"
 #include "finecap/commands.h"
 #include "finecap/error.h"
@@ -155,6 +157,7 @@ struct EvaluationRun {
   std::vector<EvaluationFigures> figures;
   std::vector<FlowComparison> flows;  // Per frame; empty sums when flow is not measured.
   FlowComparison pooled_flow;
+  std::vector<internal::HeldOutFrame> heldout;  // Per frame; empty without validation.cameras.
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
@@ -181,6 +184,11 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
                                                config.eval.camera, capture, &fields)
                             : FlowComparison());
   run->pooled_flow.Add(run->flows.back());
+  if (!config.validation.cameras.empty()) {
+    run->heldout.push_back(internal::EvaluateHeldOutFrame(
+        config, frame.name, internal::ReadFrameInput(capture, frame.index), input, refined,
+        eval_dir, &run->pictures));
+  }
   const Camera& camera = capture->cameras()[config.eval.camera];
   const cv::Mat image = capture->ReadImage(config.eval.camera, frame.index);
   const cv::Rect box = SubjectBox(camera, input, refined);
@@ -249,12 +257,14 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
-       << ",\n  " << FlowJson(run.pooled_flow, "\n  ")
+       << ",\n  " << FlowJson(run.pooled_flow, "\n  ") << ",\n  "
+       << internal::HeldOutPooledJson(run.heldout, "\n  ")
        << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
   for (size_t i = 0; i < run.names.size(); ++i) {
     json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
-         << ", " << FlowJson(run.flows[i], " ") << ", \"figures\": " << FiguresJson(run.figures[i])
-         << "}";
+         << ", " << FlowJson(run.flows[i], " ") << ", \"heldout\": "
+         << (run.heldout.empty() ? "null" : internal::HeldOutFrameJson(run.heldout[i]))
+         << ", \"figures\": " << FiguresJson(run.figures[i]) << "}";
   }
   json << "\n  ]\n}\n";
   return json.str();
@@ -368,6 +378,7 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
 }
 
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
+                 const HeldOutOptions& heldout_options,
                  const std::vector<std::pair<std::string, std::string>>& plots,
                  const std::vector<std::pair<std::string, std::string>>& flow_plots,
                  const std::string& path) {
@@ -400,6 +411,7 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
   report.AddSection("Optical flow");
   AddFlowTable(run, &report);
   for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
+  if (!run.heldout.empty()) internal::AddHeldOutSection(run.heldout, heldout_options, &report);
   if (!plots.empty()) report.AddSection("Over the frames");
   for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
   report.AddSection("Pictures");
@@ -436,8 +448,8 @@ int RunEval(const Config& configured) {
   const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
   WriteFlowCsv(run, eval_dir + "/flow.csv");
-  WriteReport(run, sequence, WritePlots(run, eval_dir), WriteFlowPlot(run, eval_dir),
-              eval_dir + "/report.html");
+  WriteReport(run, sequence, config.validation.score, WritePlots(run, eval_dir),
+              WriteFlowPlot(run, eval_dir), eval_dir + "/report.html");
 
   std::cout.precision(3);
   std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
@@ -447,6 +459,12 @@ int RunEval(const Config& configured) {
               << " mm; detail recovered " << 100.0 * sequence.all.detail_recovered
               << " %; normal error " << sequence.all.normal_error_coarse_deg << " -> "
               << sequence.all.normal_error_refined_deg << " degrees\n";
+  }
+  if (!run.heldout.empty()) {
+    const std::vector<SurfaceScore> pooled = internal::PooledHeldOutScore(run.heldout);
+    std::cout << "Held-out cameras: NCC input " << pooled[0].ncc << ", refined " << pooled[1].ncc
+              << "; MAD input " << pooled[0].mad << ", refined " << pooled[1].mad
+              << " grey levels\n";
   }
   if (flow) {
     std::cout << "Optical flow to the images: input " << run.pooled_flow.coarse.mean_px()

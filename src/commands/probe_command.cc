@@ -51,7 +51,8 @@ int RunProbe(const Config& configured, int frame_index) {
       config.output.dir.empty() ? std::string(".") : internal::PrepareOutputFolder(config, capture);
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
-  const FrameInput input = internal::ReadFrameInput(&capture, frame);
+  FrameInput input = internal::ReadFrameInput(&capture, frame);
+  internal::TakeHeldOutViews(config, &input);  // The energy as refine sees it.
   PreparedFrame prepared = PrepareFrame(model, colors, input, config.refine);
   const FrameEnergy& energy = *prepared.energy;
 

@@ -10,6 +10,7 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
+#include "finecap/heldout_score.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
 #include "finecap/problem_size.h"
@@ -79,16 +80,43 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
       1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
 }
 
+// The held-out score of the frame's input and of its result (as solved), into `stats`; a result
+// whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
+// replaced by the input.
+void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const FrameInput& input,
+                         const std::vector<CalibratedImage>& held_out, FrameResult* result,
+                         FrameStats* stats) {
+  if (held_out.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh fine_input = model.Subdivide(input.coarse);
+  const HeldOutScore score =
+      ScoreHeldOutViews(internal::CalibratedImagesOf(input), held_out,
+                        {&fine_input, &result->refined}, config.validation.score);
+  stats->heldout_ncc_input = score.mean[0].ncc;
+  stats->heldout_ncc_refined = score.mean[1].ncc;
+  stats->heldout_mad_input = score.mean[0].mad;
+  stats->heldout_mad_refined = score.mean[1].mad;
+  stats->seconds_heldout =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
+  result->worse = stats->worse = true;
+  if (config.refine.keep_input_if_worse && !result->kept_input) {
+    KeepInputSurface(fine_input, result);
+    stats->kept_input = true;
+  }
+}
+
 // The size of the first frame's problem and what it forecasts, before the long part of the run.
 void PrintProblemSize(const Config& config, const SequenceModel& model,
                       const ReferenceColors& colors, Capture* capture, int first_frame,
                       int frames) {
-  const ProblemSize size = EstimateProblemSize(
-      model, colors, internal::ReadFrameInput(capture, first_frame), config.refine);
-  const Camera& camera = capture->cameras().front();
-  std::cerr << "finecap refine: " << frames << " frames, " << capture->num_cameras()
-            << " cameras of " << camera.width << "x" << camera.height << ", "
-            << size.num_surface_gaussians << " surface Gaussians (of " << size.num_fine_vertices
+  FrameInput first = internal::ReadFrameInput(capture, first_frame);
+  internal::TakeHeldOutViews(config, &first);  // Refine never sees them.
+  const ProblemSize size = EstimateProblemSize(model, colors, first, config.refine);
+  const Camera& camera = first.cameras.front();
+  std::cerr << "finecap refine: " << frames << " frames, " << first.cameras.size() << " cameras of "
+            << camera.width << "x" << camera.height << ", " << size.num_surface_gaussians
+            << " surface Gaussians (of " << size.num_fine_vertices
             << " vertices after subdivision), about " << internal::RoundedCount(size.num_pairs)
             << " pairs; expected peak memory " << std::lround(size.peak_memory_mb) << " MB, about "
             << internal::RoundedSeconds(size.seconds_per_frame) << " per frame\n";
@@ -131,8 +159,9 @@ int RunRefine(const Config& configured) {
     }
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> skipped;
-    const FrameInput input =
+    FrameInput input =
         internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
+    const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
     const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
     FrameResult result = warm_start.size() > 0
                              ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
@@ -145,6 +174,7 @@ int RunRefine(const Config& configured) {
 
     FrameStats stats = MakeFrameStats(name, config.refine, result);
     stats.skipped_cameras = skipped;
+    ScoreInHeldOutViews(config, model, input, held_out, &result, &stats);
     AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
     WriteMesh(files.mesh, result.refined, {result.normals, {}, quality},
@@ -160,7 +190,11 @@ int RunRefine(const Config& configured) {
     std::ostringstream detail;
     detail.precision(3);
     detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
-           << " iterations" << (stats.worse ? ", WORSE" : "");
+           << " iterations";
+    if (std::isfinite(stats.heldout_ncc_input)) {
+      detail << ", held-out NCC " << stats.heldout_ncc_input << " -> " << stats.heldout_ncc_refined;
+    }
+    detail << (stats.worse ? ", WORSE" : "") << (stats.kept_input ? " (input kept)" : "");
     if (std::isfinite(stats.rms_refined_mm)) {
       detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
       sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
