@@ -114,15 +114,22 @@ window.addEventListener("load", () => {
       : "broken: " + broken.map(i => i.alt || i.src.slice(0, 60)).join("; ");
 });'
 
-# The number of distinct colours of the screenshot (sampled on a grid), read through a canvas.
-COLOURS_SCRIPT='
-window.addEventListener("load", () => {
+# The screenshot (the <img id="shot"> of the page) drawn into a 2D canvas, whose context it returns.
+SHOT_CONTEXT='
+function shotContext() {
   const image = document.getElementById("shot");
   const canvas = document.createElement("canvas");
   canvas.width = image.naturalWidth;
   canvas.height = image.naturalHeight;
   const context = canvas.getContext("2d");
   context.drawImage(image, 0, 0);
+  return context;
+}'
+
+# The number of distinct colours of the screenshot (sampled on a grid), read through a canvas.
+COLOURS_SCRIPT="$SHOT_CONTEXT"'
+window.addEventListener("load", () => {
+  const context = shotContext(), canvas = context.canvas;
   const pixels = context.getImageData(0, 0, canvas.width, canvas.height).data;
   const colours = new Set();
   const step = 4 * 7;
@@ -145,16 +152,12 @@ window.addEventListener("load", () => {
 
 # For each half of the canvas region of the screenshot (input | refined): the percentage of
 # pixels off the background (the top-left pixel of the half) and the number of grey levels among
-# them, "PERCENT LEVELS PERCENT LEVELS". The region is inset by 4 pixels to skip the border, by 24 at the top to skip the labels.
-VIEWER_PIXELS_SCRIPT='
+# them, "PERCENT LEVELS PERCENT LEVELS". The region is inset by 4 pixels to skip the border, by
+# 24 at the top to skip the labels.
+VIEWER_PIXELS_SCRIPT="$SHOT_CONTEXT"'
 window.addEventListener("load", () => {
   const [x, y, width, height] = "RECT".split(" ").map(Number);
-  const image = document.getElementById("shot");
-  const canvas = document.createElement("canvas");
-  canvas.width = image.naturalWidth;
-  canvas.height = image.naturalHeight;
-  const context = canvas.getContext("2d");
-  context.drawImage(image, 0, 0);
+  const context = shotContext();
   const halves = [0, 1].map(half => {
     const left = x + 4 + half * Math.floor(width / 2), top = y + 24;
     const w = Math.floor(width / 2) - 8, h = height - 28;

@@ -379,8 +379,8 @@ std::string ViewerHtml(const std::vector<internal::RefinedFrame>& frames,
                        const SequenceModel& model, const Camera& camera, Capture* capture) {
   const std::optional<ThreeJsLibrary> library = FindThreeJs();
   if (!library) {
-    std::cerr << "finecap eval: warning: three.js not found (see README, 3D view); report.html "
-                 "has a note in place of the 3D view\n";
+    std::cerr << "finecap eval: warning: three.js not found (install Debian's libjs-three or set "
+                 "FINECAP_THREE_JS_DIR); report.html has a note in place of the 3D view\n";
     return MissingViewerHtml();
   }
   std::vector<ViewerFrame> shown;
