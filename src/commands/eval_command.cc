@@ -19,6 +19,7 @@
 #include "finecap/flow_evaluation.h"
 #include "finecap/html_report.h"
 #include "finecap/mesh_io.h"
+#include "finecap/mesh_viewer.h"
 #include "finecap/plot.h"
 #include "finecap/render.h"
 #include "io_util.h"
@@ -377,11 +378,35 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
   WriteTextFileAtomically(path, csv.str());
 }
 
+// Frames the report's 3D view offers: enough to see the motion, few enough to keep the report
+// small (each adds two meshes' positions).
+constexpr int kViewerFrames = 5;
+
+// The report's 3D view: the input and refined meshes of up to kViewerFrames frames, evenly spaced
+// over the evaluated ones, seen first from the eval camera. Where three.js is absent a note takes
+// its place and a warning goes to stderr: the report is still written.
+std::string ViewerHtml(const std::vector<internal::RefinedFrame>& frames,
+                       const SequenceModel& model, const Camera& camera, Capture* capture) {
+  const std::optional<ThreeJsLibrary> library = FindThreeJs();
+  if (!library) {
+    std::cerr << "finecap eval: warning: three.js not found (install Debian's libjs-three or set "
+                 "FINECAP_THREE_JS_DIR); report.html has a note in place of the 3D view\n";
+    return MissingViewerHtml();
+  }
+  std::vector<ViewerFrame> shown;
+  for (int i : EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames)) {
+    const internal::RefinedFrame& frame = frames[i];
+    shown.push_back(
+        {frame.name, model.Subdivide(capture->ReadCoarseMesh(frame.index)), ReadMesh(frame.mesh)});
+  }
+  return MeshViewerHtml(shown, camera, *library);
+}
+
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                  const HeldOutOptions& heldout_options,
                  const std::vector<std::pair<std::string, std::string>>& plots,
                  const std::vector<std::pair<std::string, std::string>>& flow_plots,
-                 const std::string& path) {
+                 const std::string& viewer_html, const std::string& path) {
   const std::vector<std::string> header = {"",
                                            "vertices",
                                            "RMS input mm",
@@ -408,6 +433,8 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
     frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
   }
   report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  report.AddSection("3D view");
+  report.AddRawHtml(viewer_html);
   report.AddSection("Optical flow");
   AddFlowTable(run, &report);
   for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
@@ -449,7 +476,9 @@ int RunEval(const Config& configured) {
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
   WriteFlowCsv(run, eval_dir + "/flow.csv");
   WriteReport(run, sequence, config.validation.score, WritePlots(run, eval_dir),
-              WriteFlowPlot(run, eval_dir), eval_dir + "/report.html");
+              WriteFlowPlot(run, eval_dir),
+              ViewerHtml(frames, model, capture.cameras()[config.eval.camera], &capture),
+              eval_dir + "/report.html");
 
   std::cout.precision(3);
   std::cout << "Evaluation: " << eval_dir << "/report.html, " << eval_dir << "/metrics.json\n";
