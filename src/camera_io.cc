@@ -1,14 +1,37 @@
 // Finding a capture's camera rig among the supported formats.
 #include "finecap/camera_io.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 
 #include "finecap/error.h"
 
 namespace finecap {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Pose2Sim names its file Calib.toml or Calib_<method>.toml, anipose calibration.toml.
+std::vector<fs::path> CalibTomlFiles(const fs::path& dir) {
+  std::vector<fs::path> files;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
+    std::string name = entry.path().filename().string();
+    std::transform(name.begin(), name.end(), name.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const bool toml = name.size() > 5 && name.compare(name.size() - 5, 5, ".toml") == 0;
+    if (toml && name.rfind("calib", 0) == 0 && entry.is_regular_file(error)) {
+      files.push_back(entry.path());
+    }
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace
 
 std::vector<Camera> ReadRig(const std::string& capture_dir) {
-  namespace fs = std::filesystem;
   const fs::path dir(capture_dir);
   std::error_code error;
   Require(fs::is_directory(dir, error), capture_dir, "capture folder not found");
@@ -17,12 +40,22 @@ std::vector<Camera> ReadRig(const std::string& capture_dir) {
   if (fs::exists(dir / "intri.yml", error) || fs::exists(dir / "extri.yml", error)) {
     return ReadIntriExtri((dir / "intri.yml").string(), (dir / "extri.yml").string());
   }
+  const std::vector<fs::path> tomls = CalibTomlFiles(dir);
+  if (tomls.size() > 1) {
+    std::string names;
+    for (const fs::path& toml : tomls)
+      names += (names.empty() ? "" : ", ") + toml.filename().string();
+    throw Error(capture_dir, "more than one calibration file (" + names +
+                                 "): keep the one that calibrates these images");
+  }
+  if (tomls.size() == 1) return ReadCalibToml(tomls.front().string());
   for (const fs::path& folder : {dir / "sparse", dir / "sparse" / "0", dir}) {
     if (fs::exists(folder / "cameras.txt", error)) return ReadColmapTextModel(folder.string());
   }
   throw Error(capture_dir,
-              "no camera rig found: expected cameras.yaml, intri.yml + extri.yml, or a COLMAP "
-              "text model (cameras.txt + images.txt in sparse/, sparse/0/ or the folder itself)");
+              "no camera rig found: expected cameras.yaml, intri.yml + extri.yml, a Calib.toml "
+              "(Pose2Sim, anipose) or a COLMAP text model (cameras.txt + images.txt in sparse/, "
+              "sparse/0/ or the folder itself)");
 }
 
 }  // namespace finecap

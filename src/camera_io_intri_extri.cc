@@ -130,9 +130,12 @@ void ReadIntrinsics(const YAML::Node& intri, const std::string& path, Camera* ca
   camera->K = RowMajor3x3(RequireMatrix(intri, "K_" + name, 3, 3, path));
   const OpenCvMatrix dist = ReadMatrix(intri, "dist_" + name, path);
   if (!dist.empty()) {
-    Require((dist.rows == 1 || dist.cols == 1) && dist.data.size() <= 5,
-            KeyLocation(path, "dist_" + name), "must be a vector of at most 5 coefficients");
-    std::copy(dist.data.begin(), dist.data.end(), camera->distortion.begin());
+    const std::string where = KeyLocation(path, "dist_" + name);
+    Require(dist.rows == 1 || dist.cols == 1, where, "must be a vector (1xN or Nx1)");
+    // EasyMocap writes 1x5; fewer than 4 (k1 alone, say) means the rest are zero.
+    std::vector<double> coefficients = dist.data;
+    if (coefficients.size() < 4) coefficients.resize(4, 0.0);
+    camera->distortion = internal::OpenCvDistortion(coefficients, where);
   }
   const YAML::Node height = intri["H_" + name];
   const YAML::Node width = intri["W_" + name];
@@ -177,13 +180,16 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
       camera.name = name;
       ReadIntrinsics(intri, intri_path, &camera);
       ReadExtrinsics(extri, extri_path, &camera);
-      internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
       cameras.push_back(camera);
     }
   } catch (const YAML::Exception& error) {
     // A yaml-cpp failure that the checks above did not foresee still ends in one Error.
     throw Error(intri_path + " / " + extri_path,
                 std::string("malformed OpenCV YAML file: ") + error.what());
+  }
+  internal::MakeRotationsExact(&cameras, extri_path);
+  for (const Camera& camera : cameras) {
+    internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
   }
   internal::RequireUniqueCameraNames(cameras, intri_path);
   return cameras;
