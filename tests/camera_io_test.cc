@@ -80,6 +80,71 @@ TEST(CamerasYamlTest, DistortionIsOptional) {
   EXPECT_EQ(cameras[0].t.z(), 2.5);
 }
 
+std::string CameraEntry(const std::string& name, const std::string& r, const std::string& extra) {
+  return "  - name: " + name + "\n    width: 640\n    height: 480\n" +
+         "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n    R: " + r + "\n    t: [0, 0, 2]\n" + extra;
+}
+
+const std::string kIdentity = "[1, 0, 0, 0, 1, 0, 0, 0, 1]";
+
+TEST(CamerasYamlTest, RationalAndThinPrismDistortionRoundTrip) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  Camera rational = MakeCamera("rational", 0.3);
+  rational.distortion = {-0.2, 0.07, 0.001, -0.002, 0.01, 0.03, -0.01, 0.004};
+  Camera prism = MakeCamera("prism", -0.4);
+  prism.distortion[10] = 0.0003;
+  WriteCamerasYaml({rational, prism, MakeCamera("plain", 1.0)}, path);
+  const std::string text = testing_util::FileBytes(path);
+  // As OpenCV counts them: 8 for the rational model, 12 with thin prism, else 5.
+  EXPECT_NE(text.find("distortion: [-0.20000000000000001, 0.070000000000000007, 0.001, -0.002, "
+                      "0.01, 0.029999999999999999, -0.01, 0.0040000000000000001]"),
+            std::string::npos)
+      << text;
+  const std::vector<Camera> read = ReadCamerasYaml(path);
+  ASSERT_EQ(read.size(), 3u);
+  ExpectSameCamera(rational, read[0]);
+  ExpectSameCamera(prism, read[1]);
+  ExpectSameCamera(MakeCamera("plain", 1.0), read[2]);
+}
+
+TEST(CamerasYamlTest, FourDistortionCoefficientsAreK1K2P1P2) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  WriteText(path, "cameras:\n" + CameraEntry("cam0", kIdentity,
+                                             "    distortion: [-0.1, 0.02, 0.001, 0.002]\n"));
+  const std::array<double, 12> expected = {-0.1, 0.02, 0.001, 0.002};
+  EXPECT_EQ(ReadCamerasYaml(path).at(0).distortion, expected);
+}
+
+// A rotation written to 6 significant digits, as a published calibration's is (orthonormal to
+// about 1.4e-6): read as the nearest rotation, with one warning for the whole file.
+TEST(CamerasYamlTest, RoundedRotationIsMadeExactWithOneWarning) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  std::string cameras = "cameras:\n";
+  const Eigen::Matrix3d exact =
+      Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, 1.0, -0.4).normalized()).toRotationMatrix();
+  std::string rounded = "[";
+  for (int i = 0; i < 9; ++i) {
+    char number[32];
+    std::snprintf(number, sizeof(number), "%.6g", exact(i / 3, i % 3));
+    rounded += std::string(i ? ", " : "") + number;
+  }
+  rounded += "]";
+  for (const char* name : {"a", "b", "c"}) cameras += CameraEntry(name, rounded, "");
+  WriteText(path, cameras);
+  ::testing::internal::CaptureStderr();
+  const std::vector<Camera> read = ReadCamerasYaml(path);
+  const std::string warnings = ::testing::internal::GetCapturedStderr();
+  ASSERT_EQ(read.size(), 3u);
+  for (const Camera& camera : read) {
+    EXPECT_LT((camera.R.transpose() * camera.R - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+    EXPECT_LT((camera.R - exact).norm(), 5e-6);
+  }
+  EXPECT_EQ(std::count(warnings.begin(), warnings.end(), '\n'), 1) << warnings;
+  EXPECT_NE(warnings.find(path), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("3 cameras"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("nearest rotation"), std::string::npos) << warnings;
+}
+
 TEST(CamerasYamlTest, WriterRefusesAnInvalidCameraAndLeavesNoFile) {
   const std::string dir = MakeTempDir("yaml");
   Camera camera = MakeCamera("cam0", 0.3);
@@ -95,13 +160,6 @@ struct BadYamlCase {
   std::vector<std::string> expected_parts;  // Besides the file name.
 };
 void PrintTo(const BadYamlCase& c, std::ostream* os) { *os << c.label; }
-
-std::string CameraEntry(const std::string& name, const std::string& r, const std::string& extra) {
-  return "  - name: " + name + "\n    width: 640\n    height: 480\n" +
-         "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n    R: " + r + "\n    t: [0, 0, 2]\n" + extra;
-}
-
-const std::string kIdentity = "[1, 0, 0, 0, 1, 0, 0, 0, 1]";
 
 class BadCamerasYamlTest : public ::testing::TestWithParam<BadYamlCase> {};
 
@@ -121,9 +179,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadYamlCase{"UnknownTopLevelKey",
                     "cameras:\n" + CameraEntry("cam0", kIdentity, "") + "units: mm\n",
                     {"unknown top-level key 'units'"}},
-        BadYamlCase{"UnknownKey",
-                    "cameras:\n" + CameraEntry("cam0", kIdentity, "    focal: 500\n"),
-                    {"cam0", "'focal'", "unknown key"}},
+        BadYamlCase{
+            "UnknownKey",
+            "cameras:\n" + CameraEntry("cam0", kIdentity, "    focal: 500\n"),
+            {"cam0", "'focal'", "unknown key; allowed: name, width, height, K, R, t, distortion"}},
         BadYamlCase{"MissingKey",
                     "cameras:\n  - name: cam0\n    width: 640\n    height: 480\n"
                     "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 2]\n",
@@ -132,6 +191,17 @@ INSTANTIATE_TEST_SUITE_P(
             "WrongType",
             "cameras:\n" + CameraEntry("cam0", kIdentity, "    distortion: [a, 0, 0, 0, 0]\n"),
             {"cam0", "'distortion'", "must be a number"}},
+        BadYamlCase{"ThreeDistortionCoefficients",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity, "    distortion: [0.1, 0, 0]\n"),
+                    {"cam0", "'distortion'", "4, 5, 8, 12 or 14 coefficients", "not 3"}},
+        BadYamlCase{"TiltedSensor",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity,
+                                               "    distortion: [0.1, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
+                                               "0, 0, 0.01, 0]\n"),
+                    {"cam0", "'distortion'", "tauX, tauY"}},
+        BadYamlCase{"ShearedR",
+                    "cameras:\n" + CameraEntry("cam0", "[1, 0.01, 0, 0, 1, 0, 0, 0, 1]", ""),
+                    {"cam0", "not a rotation", "||R^T R - I||"}},
         BadYamlCase{"FractionalWidth",
                     "cameras:\n  - name: cam0\n    width: 640.5\n    height: 480\n"
                     "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
