@@ -7,7 +7,6 @@
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
-#include <Eigen/Geometry>
 
 #include "finecap/camera_io.h"
 #include "finecap/error.h"
@@ -147,14 +146,6 @@ void ReadIntrinsics(const YAML::Node& intri, const std::string& path, Camera* ca
   }
 }
 
-// R_<cam> is a Rodrigues vector: its direction the axis, its length the angle.
-Eigen::Matrix3d RotationOfRodrigues(const std::vector<double>& r) {
-  const Eigen::Vector3d vector(r[0], r[1], r[2]);
-  const double angle = vector.norm();
-  if (angle < 1e-300) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, vector / angle).toRotationMatrix();
-}
-
 void ReadExtrinsics(const YAML::Node& extri, const std::string& path, Camera* camera) {
   const std::string& name = camera->name;
   if (!ReadMatrix(extri, "Rot_" + name, path).empty()) {
@@ -162,7 +153,8 @@ void ReadExtrinsics(const YAML::Node& extri, const std::string& path, Camera* ca
   } else {
     Require(!ReadMatrix(extri, "R_" + name, path).empty(), KeyLocation(path, "R_" + name),
             "missing key (neither R_" + name + " nor Rot_" + name + " is given)");
-    camera->R = RotationOfRodrigues(RequireMatrix(extri, "R_" + name, 3, 1, path));
+    const std::vector<double> r = RequireMatrix(extri, "R_" + name, 3, 1, path);
+    camera->R = internal::RotationOfRodrigues(Eigen::Vector3d(r[0], r[1], r[2]));
   }
   const std::vector<double> t = RequireMatrix(extri, "T_" + name, 3, 1, path);
   camera->t = Eigen::Vector3d(t[0], t[1], t[2]);

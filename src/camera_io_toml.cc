@@ -4,8 +4,6 @@
 #include <cmath>
 #include <iostream>
 
-#include <Eigen/Geometry>
-
 #include "finecap/camera_io.h"
 #include "finecap/error.h"
 #include "io_util.h"
@@ -76,7 +74,8 @@ class CameraTableReader {
           internal::OpenCvDistortion(Numbers(*distortions, "distortions", -1), where);
     }
     const std::vector<double> rotation = Numbers(Required("rotation"), "rotation", 3);
-    camera.R = RotationOfRodrigues(Eigen::Vector3d(rotation[0], rotation[1], rotation[2]));
+    camera.R =
+        internal::RotationOfRodrigues(Eigen::Vector3d(rotation[0], rotation[1], rotation[2]));
     const std::vector<double> translation = Numbers(Required("translation"), "translation", 3);
     camera.t = Eigen::Vector3d(translation[0], translation[1], translation[2]);
     return camera;
@@ -137,13 +136,6 @@ class CameraTableReader {
       for (int col = 0; col < 3; ++col) matrix(row, col) = numbers[col];
     }
     return matrix;
-  }
-
-  static Eigen::Matrix3d RotationOfRodrigues(const Eigen::Vector3d& vector) {
-    const double angle = vector.norm();
-    if (!std::isfinite(angle)) return Eigen::Matrix3d::Constant(NAN);  // Validate names it.
-    if (angle < 1e-300) return Eigen::Matrix3d::Identity();
-    return Eigen::AngleAxisd(angle, vector / angle).toRotationMatrix();
   }
 
   const TomlTable& table_;

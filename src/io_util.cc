@@ -13,6 +13,7 @@
 #include <set>
 #include <sstream>
 
+#include <Eigen/Geometry>
 #include <opencv2/imgcodecs.hpp>
 
 #include "finecap/atomic_file.h"
@@ -97,6 +98,13 @@ std::vector<double> ShortestOpenCvDistortion(const std::array<double, 12>& disto
     if (distortion[i] != 0.0) used = i < 8 ? std::max<size_t>(used, 8) : 12;
   }
   return std::vector<double>(distortion.begin(), distortion.begin() + used);
+}
+
+Eigen::Matrix3d RotationOfRodrigues(const Eigen::Vector3d& vector) {
+  const double angle = vector.norm();
+  if (!std::isfinite(angle)) return Eigen::Matrix3d::Constant(std::nan(""));
+  if (angle < 1e-300) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(angle, vector / angle).toRotationMatrix();
 }
 
 void MakeRotationsExact(std::vector<Camera>* cameras, const std::string& where) {

@@ -38,6 +38,10 @@ std::array<double, 12> OpenCvDistortion(const std::vector<double>& coefficients,
 // The fewest coefficients that hold `distortion` as OpenCV counts them: 5, 8 or 12.
 std::vector<double> ShortestOpenCvDistortion(const std::array<double, 12>& distortion);
 
+// The rotation of a Rodrigues vector (OpenCV's rvec): its direction the axis, its length the
+// angle. A non-finite vector gives a non-finite matrix, which the camera's validation names.
+Eigen::Matrix3d RotationOfRodrigues(const Eigen::Vector3d& vector);
+
 // Makes each camera's R exactly orthonormal (NearestRotation) when it is a rotation up to the
 // rounding of a file, and prints one warning naming `where` when any was further than 1e-6 from
 // orthonormal (what Camera::Validate allows). Throws Error naming `where` and the camera for an R
