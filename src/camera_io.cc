@@ -12,7 +12,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Pose2Sim names its file Calib.toml or Calib_<method>.toml, anipose calibration.toml.
+// Pose2Sim names its file Calib.toml or Calib_<method>.toml, anipose calibration.toml, FreeMoCap
+// <recording>_camera_calibration.toml; Pose2Sim's Config.toml is not one.
 std::vector<fs::path> CalibTomlFiles(const fs::path& dir) {
   std::vector<fs::path> files;
   std::error_code error;
@@ -21,7 +22,7 @@ std::vector<fs::path> CalibTomlFiles(const fs::path& dir) {
     std::transform(name.begin(), name.end(), name.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     const bool toml = name.size() > 5 && name.compare(name.size() - 5, 5, ".toml") == 0;
-    if (toml && name.rfind("calib", 0) == 0 && entry.is_regular_file(error)) {
+    if (toml && name.find("calib") != std::string::npos && entry.is_regular_file(error)) {
       files.push_back(entry.path());
     }
   }

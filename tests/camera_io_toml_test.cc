@@ -196,8 +196,12 @@ TEST(CalibTomlTest, MetadataStatesTheUnitAndAMillimetreRigIsRefusedWithout) {
 
 TEST(CalibTomlTest, ReadRigFindsItAndRefusesTwo) {
   const std::string dir = MakeTempDir("toml");
+  WriteText(dir + "/Config.toml", "[project]\nframe_rate = 60\n");  // Pose2Sim's, not a rig.
   WriteText(dir + "/Calib.toml", AniposeToml(FourCameraRig()));
   EXPECT_EQ(ReadRig(dir).size(), 4u);
+  const std::string freemocap = MakeTempDir("toml");
+  WriteText(freemocap + "/take1_camera_calibration.toml", AniposeToml(FourCameraRig()));
+  EXPECT_EQ(ReadRig(freemocap).size(), 4u);
   WriteText(dir + "/calib_old.TOML", AniposeToml(FourCameraRig()));
   ExpectErrorMentions([&] { ReadRig(dir); },
                       {dir, "Calib.toml", "calib_old.TOML", "more than one"});

@@ -82,8 +82,9 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
 std::vector<Camera> ReadCalibToml(const std::string& path);
 
 // The rig of a capture folder, in this order: cameras.yaml; intri.yml + extri.yml; a Calib.toml
-// (a file whose name, in any case, is calibration.toml or starts with "calib" and ends in ".toml",
-// e.g. Calib.toml, Calib_board.toml; more than one such file is refused as ambiguous); a COLMAP
+// (a file whose name, in any case, ends in ".toml" and contains "calib": Calib.toml,
+// Calib_board.toml, calibration.toml, take1_camera_calibration.toml; more than one such file is
+// refused as ambiguous); a COLMAP
 // text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or `capture_dir` itself (the first
 // holding a cameras.txt). Throws Error naming the folder if none is found.
 std::vector<Camera> ReadRig(const std::string& capture_dir);
