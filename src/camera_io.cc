@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "finecap/error.h"
+#include "io_util.h"
 
 namespace finecap {
 namespace {
@@ -43,10 +44,9 @@ std::vector<Camera> ReadRig(const std::string& capture_dir) {
   }
   const std::vector<fs::path> tomls = CalibTomlFiles(dir);
   if (tomls.size() > 1) {
-    std::string names;
-    for (const fs::path& toml : tomls)
-      names += (names.empty() ? "" : ", ") + toml.filename().string();
-    throw Error(capture_dir, "more than one calibration file (" + names +
+    std::vector<std::string> names;
+    for (const fs::path& toml : tomls) names.push_back(toml.filename().string());
+    throw Error(capture_dir, "more than one calibration file (" + internal::JoinWithCommas(names) +
                                  "): keep the one that calibrates these images");
   }
   if (tomls.size() == 1) return ReadCalibToml(tomls.front().string());

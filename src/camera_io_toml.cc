@@ -23,12 +23,6 @@ const std::vector<std::string> kCameraKeys = {"name",     "size",        "matrix
 // the unit of board_square_side_length, which its documentation gives in mm).
 constexpr double kLargestPlausibleRigMetres = 100.0;
 
-std::string JoinKeys(const std::vector<std::string>& keys) {
-  std::string list;
-  for (const std::string& key : keys) list += (list.empty() ? "" : ", ") + key;
-  return list;
-}
-
 // "Calib.toml line 7 (camera [cam_1], key 'matrix')".
 std::string Location(const std::string& path, int line, const std::string& table,
                      const std::string& key) {
@@ -53,7 +47,7 @@ class CameraTableReader {
   Camera Read() const {
     for (const auto& [key, value] : table_.entries) {
       Require(std::find(kCameraKeys.begin(), kCameraKeys.end(), key) != kCameraKeys.end(),
-              Where(value, key), "unknown key; allowed: " + JoinKeys(kCameraKeys));
+              Where(value, key), "unknown key; allowed: " + internal::JoinWithCommas(kCameraKeys));
     }
     Camera camera;
     camera.name = ReadName();

@@ -34,12 +34,6 @@ constexpr char kSchemaComment[] =
 const std::vector<std::string> kCameraKeys = {"name", "width", "height",    "K",
                                               "R",    "t",     "distortion"};
 
-std::string AllowedKeys() {
-  std::string list;
-  for (const std::string& key : kCameraKeys) list += (list.empty() ? "" : ", ") + key;
-  return list;
-}
-
 // The text of a mapping's key; a list or mapping used as a key (YAML allows it) is refused.
 std::string KeyText(const YAML::Node& key, const std::string& where) {
   Require(key.IsScalar(), where,
@@ -77,10 +71,7 @@ std::vector<double> ReadNumberList(const YAML::Node& node, size_t length,
                                    const std::string& where) {
   Require(node.IsSequence() && node.size() == length, where,
           "must be a list of " + std::to_string(length) + " numbers");
-  std::vector<double> values;
-  for (const YAML::Node& element : node)
-    values.push_back(ReadScalar<double>(element, where, "a number"));
-  return values;
+  return ReadNumbers(node, where);
 }
 
 Eigen::Matrix3d ReadRowMajor3x3(const YAML::Node& node, const std::string& where) {
@@ -100,7 +91,8 @@ Camera ReadCamera(const YAML::Node& node, int index, const std::string& path) {
   for (const auto& item : node) {
     const std::string key = KeyText(item.first, entry);
     Require(std::find(kCameraKeys.begin(), kCameraKeys.end(), key) != kCameraKeys.end(),
-            Location(path, camera.name, key), "unknown key; allowed: " + AllowedKeys());
+            Location(path, camera.name, key),
+            "unknown key; allowed: " + internal::JoinWithCommas(kCameraKeys));
   }
   for (const char* key : {"width", "height", "K", "R", "t"}) {
     Require(static_cast<bool>(node[key]), Location(path, camera.name, key), "missing key");

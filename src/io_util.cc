@@ -59,6 +59,12 @@ bool ParseInt(const std::string& token, int* value) {
   return true;
 }
 
+std::string JoinWithCommas(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 std::vector<std::string> SplitWhitespace(const std::string& line) {
   std::istringstream stream(line);
   std::vector<std::string> tokens;

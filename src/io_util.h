@@ -23,6 +23,9 @@ std::string ReadWholeFile(const std::string& path);
 bool ParseDouble(const std::string& token, double* value);
 bool ParseInt(const std::string& token, int* value);
 
+// "a, b, c": names listed in an error message.
+std::string JoinWithCommas(const std::vector<std::string>& names);
+
 // Whitespace-separated tokens of `line`.
 std::vector<std::string> SplitWhitespace(const std::string& line);
 
