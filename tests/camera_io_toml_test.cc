@@ -1,5 +1,6 @@
 // The Calib.toml of Pose2Sim and anipose, and the strict TOML subset it is read with.
 #include <cstdio>
+#include <filesystem>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -8,8 +9,11 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/camera_io.h"
+#include "finecap/capture.h"
 #include "finecap/error.h"
+#include "finecap/synth.h"
 #include "test_util.h"
+#include "tiny_synth.h"
 
 namespace finecap {
 namespace {
@@ -205,6 +209,23 @@ TEST(CalibTomlTest, ReadRigFindsItAndRefusesTwo) {
   WriteText(dir + "/calib_old.TOML", AniposeToml(FourCameraRig()));
   ExpectErrorMentions([&] { ReadRig(dir); },
                       {dir, "Calib.toml", "calib_old.TOML", "more than one"});
+}
+
+// A synthetic capture whose cameras.yaml is replaced by the equivalent Calib.toml opens with the
+// same cameras.
+TEST(CalibTomlTest, CaptureOpensWithACalibTomlInsteadOfCamerasYaml) {
+  const std::string dir = MakeTempDir("toml_capture");
+  GenerateSyntheticCapture(testing_util::TinySynthOptions(), dir);
+  const std::vector<Camera> rig = ReadCamerasYaml(dir + "/cameras.yaml");
+  WriteText(dir + "/Calib.toml", AniposeToml(rig));
+  std::filesystem::remove(dir + "/cameras.yaml");
+  const Capture capture = Capture::Open(dir);
+  ASSERT_EQ(capture.num_cameras(), static_cast<int>(rig.size()));
+  for (size_t c = 0; c < rig.size(); ++c) {
+    EXPECT_EQ(capture.cameras()[c].name, rig[c].name);
+    const Eigen::Vector3d point(0.05, -0.1, 0.02);
+    EXPECT_LT((capture.cameras()[c].Project(point) - rig[c].Project(point)).norm(), 1e-9);
+  }
 }
 
 struct BadTomlCase {
