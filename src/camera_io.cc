@@ -33,13 +33,18 @@ std::vector<fs::path> CalibTomlFiles(const fs::path& dir) {
 
 }  // namespace
 
-std::vector<Camera> ReadRig(const std::string& capture_dir) {
+std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source) {
   const fs::path dir(capture_dir);
   std::error_code error;
+  std::string unused;
+  std::string& read_from = source != nullptr ? *source : unused;
   Require(fs::is_directory(dir, error), capture_dir, "capture folder not found");
-  if (fs::exists(dir / "cameras.yaml", error))
+  if (fs::exists(dir / "cameras.yaml", error)) {
+    read_from = "cameras.yaml";
     return ReadCamerasYaml((dir / "cameras.yaml").string());
+  }
   if (fs::exists(dir / "intri.yml", error) || fs::exists(dir / "extri.yml", error)) {
+    read_from = "intri.yml + extri.yml";
     return ReadIntriExtri((dir / "intri.yml").string(), (dir / "extri.yml").string());
   }
   const std::vector<fs::path> tomls = CalibTomlFiles(dir);
@@ -49,9 +54,16 @@ std::vector<Camera> ReadRig(const std::string& capture_dir) {
     throw Error(capture_dir, "more than one calibration file (" + internal::JoinWithCommas(names) +
                                  "): keep the one that calibrates these images");
   }
-  if (tomls.size() == 1) return ReadCalibToml(tomls.front().string());
+  if (tomls.size() == 1) {
+    read_from = tomls.front().filename().string() + " (Pose2Sim/anipose)";
+    return ReadCalibToml(tomls.front().string());
+  }
   for (const fs::path& folder : {dir / "sparse", dir / "sparse" / "0", dir}) {
-    if (fs::exists(folder / "cameras.txt", error)) return ReadColmapTextModel(folder.string());
+    if (fs::exists(folder / "cameras.txt", error)) {
+      const std::string relative = fs::relative(folder, dir, error).string();
+      read_from = "COLMAP text model" + (relative == "." ? std::string() : " in " + relative);
+      return ReadColmapTextModel(folder.string());
+    }
   }
   throw Error(capture_dir,
               "no camera rig found: expected cameras.yaml, intri.yml + extri.yml, a Calib.toml "

@@ -81,7 +81,7 @@ Capture Capture::Open(const std::string& dir) {
   Require(fs::is_directory(dir, error), dir, "capture folder not found");
   Capture capture;
   capture.directory_ = dir;
-  capture.rig_ = ReadRig(dir);
+  capture.rig_ = ReadRig(dir, &capture.rig_source_);
   capture.FindFrames();
   capture.ReadCameras();
   capture.OpenFrameSources();

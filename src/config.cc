@@ -1,11 +1,21 @@
 #include "finecap/config.h"
 
+#include <sstream>
+
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/error.h"
+#include "finecap/scene_scale.h"
 
 namespace finecap {
 namespace {
+
+// How a length key that follows from the scene documents its default.
+std::string AutoText(double factor) {
+  std::ostringstream text;
+  text << "auto: " << factor << " scene lengths (scene length: see the README).";
+  return text.str();
+}
 
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.dir", &config->capture.dir,
@@ -53,9 +63,10 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                  0);
   schema->AddInt("model.subdivision_levels", &refine.subdivision_levels,
                  "Loop subdivision levels applied to the coarse mesh before refinement.", 0, 4);
-  schema->AddDouble("model.sigma_hat", &refine.sigma_hat,
-                    "Standard deviation of every surface Gaussian, metres (paper: 0.007).", 1e-5,
-                    1.0);
+  schema->AddDoubleOrAuto("model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
+                          "Standard deviation of every surface Gaussian, metres (paper: 0.007); " +
+                              AutoText(SceneLengthFactors().sigma_hat),
+                          1e-5, 1.0);
   schema->AddChoice("model.reference_colors", &refine.reference_colors,
                     "How the reference frame colours the surface Gaussians: pixels (the paper) or "
                     "image_model (what the energy's image model shows in the best camera).",
@@ -81,9 +92,12 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                     "A square is split while the RMS colour distance of its pixels to their "
                     "mean exceeds this.",
                     0.0, 10.0);
-  schema->AddDouble("visibility.depth_tolerance", &refine.visibility.depth_tolerance,
-                    "A vertex more than this behind the rendered input surface is occluded, m.",
-                    0.0, 10.0);
+  schema->AddDoubleOrAuto("visibility.depth_tolerance", &refine.visibility.depth_tolerance,
+                          &refine.scene_lengths.depth_tolerance,
+                          "A vertex more than this behind the rendered input surface is occluded, "
+                          "m; " +
+                              AutoText(SceneLengthFactors().depth_tolerance),
+                          0.0, 10.0);
   schema->AddDouble("visibility.max_view_angle_deg", &refine.visibility.max_view_angle_deg,
                     "Largest angle between a normal and the direction to a camera that sees it.",
                     1.0, 90.0);
@@ -92,7 +106,7 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                     0.0, 1000.0);
 }
 
-void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
+void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSchema* schema) {
   schema->AddChoice("energy.similarity", &energy->similarity,
                     "paper: the paper's E_sim as printed; surface_color: each surface Gaussian's "
                     "colour against the image around its projection (peaks at the truth).",
@@ -107,8 +121,10 @@ void AddEnergyKeys(EnergyOptions* energy, ConfigSchema* schema) {
   schema->AddDouble("energy.reach_sigmas", &energy->reach_sigmas,
                     "Pairs of Gaussians are evaluated up to this many combined sigmas apart.", 0.5,
                     10.0);
-  schema->AddDouble("energy.k_max", &energy->k_max,
-                    "Bound on the displacement along the normal, m.", 1e-5, 1.0);
+  schema->AddDoubleOrAuto(
+      "energy.k_max", &energy->k_max, &scene_lengths->k_max,
+      "Bound on the displacement along the normal, m; " + AutoText(SceneLengthFactors().k_max),
+      1e-5, 1.0);
   schema->AddDouble("energy.w_reg", &energy->w_reg, "Weight of the regulariser (paper: 1).", 0.0,
                     1e12);
   schema->AddDouble("energy.w_prior", &energy->w_prior,
@@ -149,16 +165,21 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                     "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on "
                     "the normal equations, or dense QR (tiny problems only).",
                     {"sparse_normal_cholesky", "cgnr", "dense_qr"});
-  schema->AddDouble("solver.initial_step", &solver->initial_step,
-                    "Gradient ascent: first step of the steepest k_s, m.", 1e-9, 1.0);
+  schema->AddDoubleOrAuto("solver.initial_step", &solver->initial_step,
+                          &refine->scene_lengths.initial_step,
+                          "Gradient ascent: first step of the steepest k_s, m; " +
+                              AutoText(SceneLengthFactors().initial_step),
+                          1e-9, 1.0);
   schema->AddDouble("solver.step_growth", &solver->step_growth,
                     "Gradient ascent: step factor growth while a derivative keeps its sign.", 1.0,
                     10.0);
   schema->AddDouble("solver.step_shrink", &solver->step_shrink,
                     "Gradient ascent: step factor shrink when a derivative flips its sign.", 1e-3,
                     0.999);
-  schema->AddDouble("solver.max_step", &solver->max_step,
-                    "Gradient ascent: largest step of one k_s in one iteration, m.", 1e-9, 1.0);
+  schema->AddDoubleOrAuto("solver.max_step", &solver->max_step, &refine->scene_lengths.max_step,
+                          "Gradient ascent: largest step of one k_s in one iteration, m; " +
+                              AutoText(SceneLengthFactors().max_step),
+                          1e-9, 1.0);
   schema->AddInt("solver.sweep_samples", &refine->sweep.samples,
                  "Plane-sweep start: displacements tried per surface Gaussian before solving "
                  "(0 = off, start at k = 0).",
@@ -193,7 +214,7 @@ ConfigSchema MakeConfigSchema(Config* config) {
   ConfigSchema schema;
   AddCaptureOutputRuntimeKeys(config, &schema);
   AddModelKeys(config, &schema);
-  AddEnergyKeys(&config->refine.energy, &schema);
+  AddEnergyKeys(&config->refine.energy, &config->refine.scene_lengths, &schema);
   AddSolverKeys(&config->refine.solver, &config->refine, &schema);
   AddSynthKeys(&config->synth, &schema);
   AddCompareKeys(&config->compare, &schema);

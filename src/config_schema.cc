@@ -118,6 +118,23 @@ void ConfigSchema::AddDouble(const std::string& path, double* field, const std::
           [=] { return DoubleText(*field); }});
 }
 
+void ConfigSchema::AddDoubleOrAuto(const std::string& path, double* field, bool* is_auto,
+                                   const std::string& doc, double min, double max) {
+  AddKey({path, "float", RangeText(min, max) + " or auto", doc, "",
+          [=](const YAML::Node& value, const std::string& where) {
+            if (value.IsScalar() && value.Scalar() == "auto") {
+              *is_auto = true;
+              return;
+            }
+            const double number = Convert<double>(value, where, "a number or auto");
+            Require(std::isfinite(number), where, "value must be finite");
+            RequireInRange(number, min, max, where);
+            *field = number;
+            *is_auto = false;
+          },
+          [=] { return *is_auto ? std::string("auto") : DoubleText(*field); }});
+}
+
 void ConfigSchema::AddBool(const std::string& path, bool* field, const std::string& doc) {
   AddKey({path, "bool", "true, false", doc, "",
           [=](const YAML::Node& value, const std::string& where) {

@@ -205,6 +205,37 @@ void AddFoldsKey(std::vector<FoldComponent>* folds, ConfigSchema* schema) {
       [folds] { return FoldsText(*folds); });
 }
 
+// ---- Coarse input ----
+
+const char* CoarseInputName(CoarseInput coarse) {
+  return coarse == CoarseInput::kSmoothed ? "smoothed" : "unfolded";
+}
+
+void AddCoarseInputKeys(SynthOptions* synth, ConfigSchema* schema) {
+  const std::vector<std::string> choices = {"unfolded", "smoothed"};
+  CoarseInput* coarse = &synth->coarse;
+  schema->AddCustom(
+      "synth.coarse", "choice", "unfolded, smoothed",
+      "The coarse meshes: unfolded (the true surface without its folds) or smoothed (the true "
+      "surface Taubin-smoothed, synth.smoothing).",
+      [coarse, choices](const YAML::Node& value, const std::string& where) {
+        *coarse = ParseChoice(value, where, choices) == "smoothed" ? CoarseInput::kSmoothed
+                                                                   : CoarseInput::kUnfolded;
+      },
+      [coarse] { return std::string(CoarseInputName(*coarse)); });
+  TaubinSmoothingOptions& smoothing = synth->smoothing;
+  schema->AddInt("synth.smoothing.iterations", &smoothing.iterations,
+                 "synth.coarse smoothed: Taubin iterations (lambda and mu step each), the "
+                 "strength of the smoothing.",
+                 1, 100000);
+  schema->AddDouble("synth.smoothing.lambda", &smoothing.lambda, "Taubin's shrinking step factor.",
+                    1e-3, 1.0);
+  schema->AddDouble("synth.smoothing.mu", &smoothing.mu,
+                    "Taubin's inflating step factor (negative, usually slightly larger in "
+                    "magnitude than lambda; (1 - 2 lambda)(1 - 2 mu) >= -1).",
+                    -1.0, 0.0);
+}
+
 // ---- Sections ----
 
 void AddSkirtKeys(SkirtOptions* skirt, ConfigSchema* schema) {
@@ -247,7 +278,8 @@ void AddGeometryKeys(SynthOptions* synth, ConfigSchema* schema) {
   schema->AddDouble("synth.single_wavelength", &synth->single_wavelength,
                     "When > 0, every fold gets this wavelength, m (0.01 to 2); 0 = off.", 0.0, 2.0);
   schema->AddInt("synth.fold_ramp_frames", &synth->fold_ramp_frames,
-                 "Folds grow from zero at frame 0 to full at this frame; 0 = full from frame 0.",
+                 "Folds grow from zero at frame 0 to full at this frame; 0 = full from frame 0 "
+                 "(a ramp leaves the reference frame's coarse mesh exact).",
                  0);
   schema->AddDouble("synth.misalignment", &synth->misalignment,
                     "Peak of the smooth random displacement added to the coarse meshes, m.", 0.0,
@@ -331,6 +363,7 @@ void AddSynthKeys(SynthOptions* options, ConfigSchema* schema) {
                     {"skirt", "mesh"});
   AddSkirtKeys(&options->skirt, schema);
   AddGeometryKeys(options, schema);
+  AddCoarseInputKeys(options, schema);
   AddTextureKeys(&options->texture, schema);
   AddRigKeys(&options->cameras, schema);
   AddRenderKeys(&options->render, schema);

@@ -7,6 +7,15 @@
 
 namespace finecap {
 
+PairOptions EnergyPairOptions(const EnergyOptions& options) {
+  PairOptions pair_options;
+  pair_options.k_max = options.k_max;
+  pair_options.reach_sigmas = options.reach_sigmas;
+  // The paper's similarity weighs pairs by colour agreement; the colour residual compares
+  // colours itself and needs every pair in reach.
+  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  return pair_options;
+}
 
 namespace {
 
@@ -18,12 +27,7 @@ const EnergyOptions& Checked(const EnergyOptions& options) {
 std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
                                    const std::vector<CameraInput>& cameras,
                                    const EnergyOptions& options) {
-  PairOptions pair_options;
-  pair_options.k_max = options.k_max;
-  pair_options.reach_sigmas = options.reach_sigmas;
-  // The paper's similarity weighs pairs by colour agreement; the colour residual compares
-  // colours itself and needs every pair in reach.
-  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  const PairOptions pair_options = EnergyPairOptions(options);
   std::vector<EnergyView> views(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     Require(cameras[c].visible.size() == static_cast<size_t>(surface.size()),

@@ -48,7 +48,51 @@ void ReachableImageGaussians(const Camera& camera, const ImageGaussians& image,
   std::sort(reached->begin(), reached->end());
 }
 
+// The pairs of surface Gaussian s: image Gaussians in reach with a non-zero colour weight.
+void PairsOf(const Camera& camera, const ImageGaussians& image, const SurfaceGaussians& surface,
+             int s, const PairOptions& options, std::vector<int>* candidates,
+             std::vector<int>* reached, std::vector<int>* ids, std::vector<float>* weights) {
+  ReachableImageGaussians(camera, image, surface, s, options, candidates, reached);
+  for (int i : *reached) {
+    const double weight =
+        options.color_cutoff > 0.0
+            ? Wendland(ColorDistance(image[i].Color(), surface.colors[s], surface.color_space),
+                       options.color_cutoff)
+            : 1.0;
+    if (weight <= 0.0) continue;
+    ids->push_back(i);
+    weights->push_back(static_cast<float>(weight));
+  }
+}
+
 }  // namespace
+
+double CountCameraPairs(const Camera& camera, const ImageGaussians& image,
+                        const SurfaceGaussians& surface, const std::vector<unsigned char>& visible,
+                        const PairOptions& options, int stride) {
+  std::vector<int> visible_ids;
+  for (int s = 0; s < surface.size(); ++s) {
+    if (visible[s]) visible_ids.push_back(s);
+  }
+  const int n = static_cast<int>(visible_ids.size());
+  const int step = std::max(1, stride);
+  long counted = 0, sampled = 0;
+#pragma omp parallel reduction(+ : counted, sampled)
+  {
+    std::vector<int> candidates, reached, ids;
+    std::vector<float> weights;
+#pragma omp for schedule(dynamic, 16)
+    for (int j = 0; j < n; j += step) {
+      ids.clear();
+      weights.clear();
+      PairsOf(camera, image, surface, visible_ids[j], options, &candidates, &reached, &ids,
+              &weights);
+      counted += static_cast<long>(ids.size());
+      ++sampled;
+    }
+  }
+  return sampled > 0 ? double(counted) * n / sampled : 0.0;
+}
 
 CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
                              const SurfaceGaussians& surface,
@@ -67,18 +111,8 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
     std::vector<int> candidates, reached;
 #pragma omp for schedule(dynamic, 64)
     for (int j = 0; j < n; ++j) {
-      const int s = pairs.surface_ids[j];
-      ReachableImageGaussians(camera, image, surface, s, options, &candidates, &reached);
-      for (int i : reached) {
-        const double weight =
-            options.color_cutoff > 0.0
-                ? Wendland(ColorDistance(image[i].Color(), surface.colors[s], surface.color_space),
-                           options.color_cutoff)
-                : 1.0;
-        if (weight <= 0.0) continue;
-        ids[j].push_back(i);
-        weights[j].push_back(static_cast<float>(weight));
-      }
+      PairsOf(camera, image, surface, pairs.surface_ids[j], options, &candidates, &reached, &ids[j],
+              &weights[j]);
     }
   }
   pairs.begin.assign(n + 1, 0);

@@ -1,10 +1,128 @@
 #include "finecap/scene_scale.h"
 
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
 #include <sstream>
 
+#include "finecap/capture.h"
 #include "finecap/error.h"
+#include "finecap/mesh_edges.h"
+#include "finecap/subdivision.h"
 
 namespace finecap {
+namespace {
+
+double MeanEdgeLength(const Mesh& mesh) {
+  const MeshEdges edges = BuildMeshEdges(mesh.faces);
+  if (edges.num_edges() == 0) return 0.0;
+  double sum = 0.0;
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    sum +=
+        (mesh.vertices.col(edges.vertices(0, e)) - mesh.vertices.col(edges.vertices(1, e))).norm();
+  }
+  return sum / edges.num_edges();
+}
+
+// Median of depth / focal over every (camera, vertex in front of it and inside its image).
+double MedianPixelFootprint(const Mesh& mesh, const std::vector<Camera>& cameras) {
+  std::vector<double> footprints;
+  for (const Camera& camera : cameras) {
+    const Camera pinhole = camera.Undistorted();
+    for (int v = 0; v < mesh.num_vertices(); ++v) {
+      const double depth = pinhole.Depth(mesh.vertices.col(v));
+      if (!(depth > 0.0)) continue;
+      const Eigen::Vector2d pixel = pinhole.Project(mesh.vertices.col(v));
+      if (pixel.x() < 0 || pixel.y() < 0 || pixel.x() >= camera.width ||
+          pixel.y() >= camera.height) {
+        continue;
+      }
+      footprints.push_back(depth / pinhole.focal());
+    }
+  }
+  if (footprints.empty()) return 0.0;
+  const auto middle = footprints.begin() + footprints.size() / 2;
+  std::nth_element(footprints.begin(), middle, footprints.end());
+  return *middle;
+}
+
+// Replaces `*value` by factor * scene length when `from_scene`, and reports it.
+ChosenLength Choose(const std::string& key, double factor, double scene_length, double* value,
+                    bool from_scene) {
+  if (from_scene) *value = factor * scene_length;
+  return {key, *value, from_scene};
+}
+
+}  // namespace
+
+std::string LengthText(double metres) {
+  std::ostringstream text;
+  text << std::setprecision(3);
+  if (std::abs(metres) >= 1.0) {
+    text << metres << " m";
+  } else {
+    text << 1000.0 * metres << " mm";
+  }
+  return text.str();
+}
+
+SceneScale MeasureSceneScale(const Mesh& fine, const std::vector<Camera>& cameras) {
+  SceneScale scale;
+  scale.diagonal = BoundingBoxDiagonal(fine);
+  scale.mean_edge_length = MeanEdgeLength(fine);
+  scale.pixel_footprint = MedianPixelFootprint(fine, cameras);
+  scale.length =
+      std::max(scale.mean_edge_length, kFootprintsPerSceneLength * scale.pixel_footprint);
+  return scale;
+}
+
+SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
+                                             const std::vector<Camera>& cameras,
+                                             const std::string& where, RefineOptions* options) {
+  const SubdivisionStencil stencil =
+      BuildLoopSubdivision(reference_coarse, options->subdivision_levels, where);
+  SceneScaleDefaults defaults;
+  defaults.scale =
+      MeasureSceneScale(ApplySubdivision(stencil, reference_coarse.vertices, where), cameras);
+  const double s = defaults.scale.length;
+  Require(s > 0.0, where,
+          "the mesh has no extent (every edge has length 0), so no length can follow from it");
+  const SceneLengthFactors factors;
+  const SceneLengths& marks = options->scene_lengths;
+  defaults.lengths = {
+      Choose("model.sigma_hat", factors.sigma_hat, s, &options->sigma_hat, marks.sigma_hat),
+      Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max),
+      Choose("visibility.depth_tolerance", factors.depth_tolerance, s,
+             &options->visibility.depth_tolerance, marks.depth_tolerance),
+      Choose("solver.initial_step", factors.initial_step, s, &options->solver.initial_step,
+             marks.initial_step),
+      Choose("solver.max_step", factors.max_step, s, &options->solver.max_step, marks.max_step),
+  };
+  return defaults;
+}
+
+SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int reference_frame,
+                                             RefineOptions* options) {
+  Require(reference_frame >= 0 && reference_frame < capture.num_frames(), "model.reference_frame",
+          "frame " + std::to_string(reference_frame) + " does not exist in " + capture.directory() +
+              " (" + std::to_string(capture.num_frames()) + " frames)");
+  return ResolveSceneScaleDefaults(capture.ReadCoarseMesh(reference_frame), capture.cameras(),
+                                   capture.mesh_path(reference_frame), options);
+}
+
+std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults) {
+  const SceneScale& scale = defaults.scale;
+  std::ostringstream text;
+  text << "scene length " << LengthText(scale.length) << " = max(mean edge after subdivision "
+       << LengthText(scale.mean_edge_length) << ", " << kFootprintsPerSceneLength
+       << " x pixel footprint " << LengthText(scale.pixel_footprint) << "); ";
+  for (size_t i = 0; i < defaults.lengths.size(); ++i) {
+    const ChosenLength& length = defaults.lengths[i];
+    text << (i ? ", " : "") << length.key << " " << LengthText(length.value)
+         << (length.from_scene ? " (auto)" : " (set)");
+  }
+  return text.str();
+}
 
 void SceneScaleLimits::Check() const {
   Require(min_sigmas > 0.0, "SceneScaleLimits::min_sigmas", "must be positive");

@@ -20,6 +20,7 @@
 #include "finecap/error.h"
 #include "finecap/mesh_io.h"
 #include "finecap/mesh_ray_caster.h"
+#include "finecap/mesh_smoothing.h"
 #include "io_util.h"
 #include "synth_internal.h"
 
@@ -131,6 +132,19 @@ Eigen::VectorXd CastAlongNormals(const Mesh& coarse, const Mesh& truth, double m
     k(v) = hit ? *hit : std::numeric_limits<double>::quiet_NaN();
   }
   return k;
+}
+
+// The coarse input of a frame before misalignment (see CoarseInput). Smoothed: the true surface
+// at the coarse vertices, which are vertices of the true mesh displaced by their fold along their
+// smooth normal, then smoothed over the coarse mesh.
+Eigen::Matrix3Xd CoarseInputVertices(const SynthOptions& options, const Subject& subject,
+                                     const synth_internal::SmoothFrame& smooth,
+                                     const Eigen::VectorXd& folds_at_coarse) {
+  if (options.coarse == CoarseInput::kUnfolded) return smooth.coarse_vertices;
+  Mesh detailed;
+  detailed.faces = subject.coarse_faces;
+  detailed.vertices = smooth.coarse_vertices + smooth.coarse_normals * folds_at_coarse.asDiagonal();
+  return TaubinSmooth(detailed, options.smoothing);
 }
 
 // For a camera with lens distortion: where each pixel of the distorted image lies in an
@@ -276,9 +290,10 @@ SyntheticFrame SyntheticCapture::Frame(int index) const {
   frame.truth.faces = subject.fine_faces;
   frame.truth.vertices =
       smooth.fine_vertices + smooth.fine_normals * fold(subject.fine_material).asDiagonal();
-  frame.coarse.faces = subject.coarse_faces;
-  frame.coarse.vertices = smooth.coarse_vertices + impl.misalignment;
   frame.folds_at_coarse = fold(subject.coarse_material);
+  frame.coarse.faces = subject.coarse_faces;
+  frame.coarse.vertices =
+      CoarseInputVertices(impl.options, subject, smooth, frame.folds_at_coarse) + impl.misalignment;
   frame.smooth_normals = smooth.coarse_normals;
   frame.true_k = CastAlongNormals(frame.coarse, frame.truth, impl.options.max_displacement);
   return frame;

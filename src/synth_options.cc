@@ -1,8 +1,11 @@
-// Validation of the synthetic capture options.
+// Validation of the synthetic capture options, and of the smoothing they use (mesh_smoothing.h):
+// pure checks, apart from the generator's code, so that reading a config links no geometry (the
+// config fuzzer builds from the parser sources alone).
 #include <cmath>
 #include <string>
 
 #include "finecap/error.h"
+#include "finecap/mesh_smoothing.h"
 #include "finecap/synth.h"
 
 namespace finecap {
@@ -22,6 +25,21 @@ void RequireRange(double value, double low, double high, const std::string& wher
 bool IsPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 }  // namespace
+
+void TaubinSmoothingOptions::Check(const std::string& where) const {
+  Require(iterations >= 1 && iterations <= 100000, where + ".iterations",
+          "is " + std::to_string(iterations) + " but must lie in [1, 100000]");
+  RequireRange(lambda, 1e-3, 1.0, where + ".lambda");
+  RequireRange(mu, -1.0, 0.0, where + ".mu");
+  // The fastest wave a mesh carries (Laplacian eigenvalue 2) is scaled by this per iteration;
+  // below -1 it would grow from one iteration to the next instead of fading.
+  const double fastest = (1.0 - 2.0 * lambda) * (1.0 - 2.0 * mu);
+  Require(fastest >= -1.0, where + ".mu",
+          "is " + std::to_string(mu) + " with lambda " + std::to_string(lambda) +
+              ": together they make the smoothing unstable ((1 - 2 lambda)(1 - 2 mu) = " +
+              std::to_string(fastest) + " < -1, the finest detail grows); use a smaller lambda " +
+              "or |mu|");
+}
 
 void FoldComponent::Check(const std::string& where) const {
   RequireRange(amplitude, -0.1, 0.1, where + ".amplitude");
@@ -110,6 +128,7 @@ void SynthOptions::Check() const {
   RequireRange(misalignment, 0.0, 0.1, where + "misalignment");
   RequireRange(misalignment_wavelength, 0.01, 100.0, where + "misalignment_wavelength");
   RequireRange(max_displacement, 1e-4, 10.0, where + "max_displacement");
+  smoothing.Check(where + "smoothing");
   texture.Check();
   cameras.Check();
   render.Check();

@@ -202,7 +202,9 @@ TEST(CalibTomlTest, ReadRigFindsItAndRefusesTwo) {
   const std::string dir = MakeTempDir("toml");
   WriteText(dir + "/Config.toml", "[project]\nframe_rate = 60\n");  // Pose2Sim's, not a rig.
   WriteText(dir + "/Calib.toml", AniposeToml(FourCameraRig()));
-  EXPECT_EQ(ReadRig(dir).size(), 4u);
+  std::string source;
+  EXPECT_EQ(ReadRig(dir, &source).size(), 4u);
+  EXPECT_EQ(source, "Calib.toml (Pose2Sim/anipose)");
   const std::string freemocap = MakeTempDir("toml");
   WriteText(freemocap + "/take1_camera_calibration.toml", AniposeToml(FourCameraRig()));
   EXPECT_EQ(ReadRig(freemocap).size(), 4u);

@@ -10,9 +10,6 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/synth.h"
-#include "tiny_synth.h"
-
 namespace {
 
 namespace fs = std::filesystem;
@@ -50,7 +47,7 @@ fs::path FreshFolder(const std::string& name) {
 TEST(CliTest, HelpListsTheSubcommands) {
   const RunResult result = RunFinecap("--help");
   EXPECT_EQ(result.exit_code, 0);
-  for (const char* subcommand : {"synth", "refine", "probe"}) {
+  for (const char* subcommand : {"synth", "refine", "probe", "info"}) {
     EXPECT_NE(result.output.find(std::string("  ") + subcommand + "\n"), std::string::npos)
         << subcommand;
   }
@@ -88,19 +85,89 @@ TEST(CliTest, UnknownConfigKeyNamesFileAndKey) {
       << result.output;
 }
 
+// A 3-camera synthetic capture of 96 x 96 pixels, one frame, made by `finecap synth`.
+fs::path TinyCapture(const std::string& name) {
+  const fs::path capture = FreshFolder(name) / "capture";
+  const RunResult result =
+      RunFinecap("synth --out " + capture.string() +
+                 " --set synth.num_frames=1,synth.skirt.around=16,synth.skirt.down=8,"
+                 "synth.texture.width=256,synth.texture.height=128,synth.cameras.count=3,"
+                 "synth.cameras.width=96,synth.cameras.height=96,synth.cameras.focal=300,"
+                 "synth.render.supersampling=1");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  return capture;
+}
+
+int CountFiles(const fs::path& folder) {
+  int files = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(folder))
+    files += entry.is_regular_file();
+  return files;
+}
+
+// The number after `label` in `text`, or -1.
+long NumberAfter(const std::string& text, const std::string& label) {
+  const size_t at = text.find(label);
+  return at == std::string::npos ? -1 : std::stol(text.substr(at + label.size()));
+}
+
+TEST(CliTest, InfoPrintsTheCaptureAndWritesNothing) {
+  const fs::path capture = TinyCapture("info");
+  const int files = CountFiles(capture);
+  const fs::path out = capture / ".." / "out";
+  const RunResult result =
+      RunFinecap("info --capture " + capture.string() + " --out " + out.string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(CountFiles(capture), files);
+  for (const char* item :
+       {"cameras: 3, read from cameras.yaml", "cam00: 96x96", "cam02: 96x96", "frames: 1",
+        "mesh: 128 vertices", "after 1 subdivision level", "scene: extent", "pixel footprint",
+        "model.sigma_hat", "energy.k_max", "visibility.depth_tolerance", "(auto)",
+        "vertices refined:", "pairs of Gaussians", "forecast per frame: peak memory"}) {
+    EXPECT_NE(result.output.find(item), std::string::npos) << item << "\n" << result.output;
+  }
+  EXPECT_GT(NumberAfter(result.output, "forecast per frame: peak memory "), 0) << result.output;
+  // A length set on the command line is used and said to be set.
+  const RunResult set =
+      RunFinecap("info --capture " + capture.string() + " --set model.sigma_hat=0.0123");
+  EXPECT_NE(set.output.find("model.sigma_hat 12.3 mm (set)"), std::string::npos) << set.output;
+}
+
+TEST(CliTest, InfoForecastsTheMemoryRefinePrints) {
+  const fs::path capture = TinyCapture("info_forecast");
+  const RunResult info = RunFinecap("info --capture " + capture.string());
+  const fs::path out = capture / ".." / "out";
+  const RunResult refine = RunFinecap("refine --capture " + capture.string() + " --out " +
+                                      out.string() + " --set solver.max_iterations=1");
+  ASSERT_EQ(refine.exit_code, 0) << refine.output;
+  const long forecast = NumberAfter(info.output, "forecast per frame: peak memory ");
+  EXPECT_GT(forecast, 0) << info.output;
+  EXPECT_EQ(NumberAfter(refine.output, "expected peak memory "), forecast) << refine.output;
+}
+
+TEST(CliTest, InfoWarnsAboutVerticesNoCameraSees) {
+  const fs::path capture = TinyCapture("info_unseen");
+  const RunResult result =
+      RunFinecap("info --capture " + capture.string() + " --set visibility.max_view_angle_deg=1");
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("warning: "), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("seen by no camera within visibility.max_view_angle_deg 1"),
+            std::string::npos)
+      << result.output;
+}
+
 // Without --out the probe writes into a new folder under $TMPDIR, and nothing into the folder it
 // is run from.
 TEST(CliTest, ProbeWithoutOutWritesNothingIntoTheCurrentDirectory) {
-  const fs::path folder = FreshFolder("probe");
-  const fs::path capture = folder / "capture";
-  const fs::path working = folder / "working";
-  const fs::path temp = folder / "tmp";
-  finecap::GenerateSyntheticCapture(finecap::testing_util::TinySynthOptions(), capture.string());
+  const fs::path capture = TinyCapture("probe");
+  const fs::path working = capture.parent_path() / "working";
+  const fs::path temp = capture.parent_path() / "tmp";
   fs::create_directories(working);
   fs::create_directories(temp);
   const RunResult result =
       RunFinecapIn(working, "TMPDIR=" + temp.string(),
-                   "probe --capture " + capture.string() + " --frame 1 --set runtime.threads=1");
+                   "probe --capture " + capture.string() + " --set runtime.threads=1");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   EXPECT_TRUE(fs::is_empty(working));
   const std::string prefix = "plot: " + (temp / "finecap-probe-").string();

@@ -133,6 +133,61 @@ TEST(ConfigSynthTest, PresetValuesMatchTheirFiles) {
   EXPECT_EQ(plain.texture.textureless_color, Eigen::Vector3d(0.62, 0.55, 0.48));
 }
 
+// A real capture's reference frame is as coarse as any other, so the presets put folds in frame 0;
+// only the demo and the variants named *_ramp grow them from zero (an exact reference frame).
+TEST(ConfigSynthTest, OnlyTheDemoAndRampVariantsRampTheFolds) {
+  int ramped = 0;
+  for (const std::string& preset : SynthPresets()) {
+    SCOPED_TRACE(preset);
+    const std::string name = std::filesystem::path(preset).stem().string();
+    const bool named_ramped =
+        name == "synth_demo" || (name.size() > 5 && name.compare(name.size() - 5, 5, "_ramp") == 0);
+    const SynthOptions synth = LoadConfig(preset, {}).synth;
+    EXPECT_EQ(synth.fold_ramp_frames > 0, named_ramped);
+    ramped += named_ramped;
+  }
+  EXPECT_GE(ramped, 2);  // The demo and synth_skirt_ramp at least.
+  const std::string configs = std::string(FINECAP_SOURCE_DIR) + "/configs/";
+  EXPECT_EQ(LoadConfig(configs + "synth_skirt_ramp.yaml", {}).synth.fold_ramp_frames, 3);
+  const SynthOptions smoothed = LoadConfig(configs + "synth_skirt_smoothed.yaml", {}).synth;
+  EXPECT_EQ(smoothed.coarse, CoarseInput::kSmoothed);
+  EXPECT_EQ(smoothed.fold_ramp_frames, 0);
+  EXPECT_EQ(LoadConfig(configs + "synth_skirt.yaml", {}).synth.coarse, CoarseInput::kUnfolded);
+}
+
+TEST(ConfigSynthTest, CoarseInputAndSmoothingKeys) {
+  const Config config = LoadConfig("", {{"synth.coarse", "smoothed", "--set"},
+                                        {"synth.smoothing.iterations", "25", "--set"},
+                                        {"synth.smoothing.lambda", "0.6307", "--set"},
+                                        {"synth.smoothing.mu", "-0.6732", "--set"}});
+  EXPECT_EQ(config.synth.coarse, CoarseInput::kSmoothed);
+  EXPECT_EQ(config.synth.smoothing.iterations, 25);
+  EXPECT_EQ(config.synth.smoothing.lambda, 0.6307);
+  EXPECT_EQ(config.synth.smoothing.mu, -0.6732);
+  Config defaults;
+  EXPECT_EQ(MakeConfigSchema(&defaults).ValueText("synth.coarse"), "unfolded");
+  EXPECT_EQ(defaults.synth.coarse, CoarseInput::kUnfolded);
+}
+
+TEST(ConfigSynthTest, SmoothingStrengthOutOfRangeIsOneErrorNamingTheKey) {
+  ExpectSetRefused("synth.coarse", "blurred", {"unfolded, smoothed"});
+  ExpectSetRefused("synth.smoothing.iterations", "0", {"outside [1, 100000]"});
+  ExpectSetRefused("synth.smoothing.iterations", "2.5", {"expected an integer"});
+  ExpectSetRefused("synth.smoothing.lambda", "0", {"outside [0.001, 1]"});
+  ExpectSetRefused("synth.smoothing.mu", "0.5", {"outside [-1, 0]"});
+  // Each in range, together unstable: named by the config and the key.
+  ExpectErrorMentions(
+      [] {
+        LoadConfig("", {{"synth.smoothing.lambda", "0.95", "--set"},
+                        {"synth.smoothing.mu", "-1", "--set"}});
+      },
+      {"synth.smoothing.mu", "unstable"});
+  const std::string file =
+      WriteConfig("smoothing.yaml", "synth:\n  smoothing:\n    iterations: -1\n");
+  ExpectErrorMentions([&] { LoadConfig(file, {}); },
+                      {"smoothing.yaml", "synth.smoothing.iterations", "outside [1, 100000]"});
+}
+
 TEST(ConfigSynthTest, PresetsSetExactlyTheSchemaKeys) {
   Config config;
   const std::vector<std::string> listed = HelpPaths(MakeConfigSchema(&config).HelpText("synth."));
@@ -148,7 +203,7 @@ TEST(ConfigSynthTest, HelpListsEverySynthKeyOnceWithADoc) {
   Config config;
   const std::string help = MakeConfigSchema(&config).HelpText("synth.");
   const std::vector<std::string> listed = HelpPaths(help);
-  EXPECT_EQ(listed.size(), 48u) << help;
+  EXPECT_EQ(listed.size(), 52u) << help;
   EXPECT_EQ(std::set<std::string>(listed.begin(), listed.end()).size(), listed.size()) << help;
   for (const char* key : {"synth.folds", "synth.seed", "synth.cameras.distortion",
                           "synth.render.noise_seed", "synth.texture.textureless_color"}) {
@@ -210,7 +265,7 @@ TEST(ConfigSynthTest, EveryValuePrintsAsYamlThatReadsBackUnchanged) {
   Config reread;
   ConfigSchema reader = MakeConfigSchema(&reread);
   const std::vector<std::string> keys = HelpPaths(printer.HelpText("synth."));
-  ASSERT_EQ(keys.size(), 48u);
+  ASSERT_EQ(keys.size(), 52u);
   for (const std::string& key : keys) reader.Set(key, printer.ValueText(key), "test");
 
   const SynthOptions& expected = noisy.synth;

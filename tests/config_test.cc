@@ -100,6 +100,50 @@ TEST(ConfigTest, BadFrameRangeIsRefused) {
   EXPECT_EQ(LoadConfig("", {{"capture.frames", "3:", "--frames"}}).frame_range().begin, 3);
 }
 
+TEST(ConfigTest, SceneLengthsAreAutoUnlessSetAndASetValueWins) {
+  const Config defaults = LoadConfig("", {});
+  EXPECT_TRUE(defaults.refine.scene_lengths.sigma_hat);
+  EXPECT_TRUE(defaults.refine.scene_lengths.k_max);
+  EXPECT_TRUE(defaults.refine.scene_lengths.depth_tolerance);
+  EXPECT_TRUE(defaults.refine.scene_lengths.initial_step);
+  EXPECT_TRUE(defaults.refine.scene_lengths.max_step);
+
+  // A file that sets a length keeps it, as before; the others stay auto.
+  const std::string file =
+      WriteTempFile("lengths.yaml", "model:\n  sigma_hat: 0.004\nenergy:\n  k_max: auto\n");
+  const Config from_file = LoadConfig(file, {});
+  EXPECT_FALSE(from_file.refine.scene_lengths.sigma_hat);
+  EXPECT_DOUBLE_EQ(from_file.refine.sigma_hat, 0.004);
+  EXPECT_TRUE(from_file.refine.scene_lengths.k_max);
+  EXPECT_TRUE(from_file.refine.scene_lengths.depth_tolerance);
+
+  // --set wins over the file, both ways.
+  const Config overridden =
+      LoadConfig(file, {{"model.sigma_hat", "auto", "--set"}, {"energy.k_max", "0.03", "--set"}});
+  EXPECT_TRUE(overridden.refine.scene_lengths.sigma_hat);
+  EXPECT_FALSE(overridden.refine.scene_lengths.k_max);
+  EXPECT_DOUBLE_EQ(overridden.refine.energy.k_max, 0.03);
+
+  Config config;
+  const ConfigSchema schema = MakeConfigSchema(&config);
+  EXPECT_EQ(schema.ValueText("model.sigma_hat"), "auto");
+  EXPECT_NE(schema.HelpText().find("model.sigma_hat (float [1e-05, 1] or auto, default auto)"),
+            std::string::npos)
+      << schema.HelpText();
+}
+
+TEST(ConfigTest, ASceneLengthThatIsNeitherANumberNorAutoIsRefused) {
+  const std::string message = ErrorMessage([] {
+    LoadConfig("", {{"energy.k_max", "automatic", "--set"}});
+  });
+  EXPECT_NE(message.find("energy.k_max"), std::string::npos) << message;
+  EXPECT_NE(message.find("a number or auto"), std::string::npos) << message;
+  const std::string range = ErrorMessage([] {
+    LoadConfig("", {{"model.sigma_hat", "2", "--set"}});
+  });
+  EXPECT_NE(range.find("outside [1e-05, 1]"), std::string::npos) << range;
+}
+
 TEST(ConfigTest, HelpListsEveryKeyWithItsDefault) {
   Config config;
   const std::string help = MakeConfigSchema(&config).HelpText();

@@ -18,6 +18,7 @@
 #include "finecap/error.h"
 #include "finecap/mesh_io.h"
 #include "finecap/render.h"
+#include "test_meshes.h"
 #include "tiny_synth.h"
 
 namespace finecap {
@@ -145,7 +146,7 @@ TEST(SynthTest, FoldsFollowTheDocumentedFormula) {
   fold.phase = 30.0;
   fold.drift = 20.0;
   options.folds = {fold};
-  options.fold_ramp_frames = 4;
+  options.fold_ramp_frames = 4;  // The ramp itself is under test.
   options.num_frames = 3;
   const SyntheticCapture capture(options);
   const double mean_radius = 0.5 * (options.skirt.waist_radius + options.skirt.hem_radius);
@@ -160,8 +161,69 @@ TEST(SynthTest, FoldsFollowTheDocumentedFormula) {
                             std::sin(waves * theta + (30.0 + 20.0 * frame_index) * M_PI / 180.0);
     EXPECT_NEAR(frame.folds_at_coarse(v), expected, 1e-12);
   }
-  // Frame 0 is the smooth reference pose.
+  // With a ramp, frame 0 is the smooth pose.
   EXPECT_EQ(capture.Frame(0).folds_at_coarse.cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(SynthTest, TheReferenceFrameHasFoldsByDefault) {
+  SynthOptions options = TinyOptions();
+  options.fold_ramp_frames = SynthOptions().fold_ramp_frames;
+  EXPECT_EQ(options.fold_ramp_frames, 0);
+  const SyntheticFrame first = SyntheticCapture(options).Frame(0);
+  EXPECT_GT(first.folds_at_coarse.cwiseAbs().maxCoeff(), 0.005);
+  int folded = 0;
+  for (int v = 0; v < first.true_k.size(); ++v) folded += std::abs(first.true_k(v)) > 0.002;
+  EXPECT_GT(folded, first.true_k.size() / 4);
+}
+
+TEST(SynthTest, SmoothedCoarseMeshesAreSmoothedCopiesOfTheTruth) {
+  SynthOptions options = TinyOptions();
+  options.skirt.around = 48;
+  options.skirt.down = 16;
+  const SyntheticFrame unfolded = SyntheticCapture(options).Frame(1);
+  options.coarse = CoarseInput::kSmoothed;
+  const SyntheticFrame smoothed = SyntheticCapture(options).Frame(1);
+  EXPECT_EQ(smoothed.truth.vertices, unfolded.truth.vertices);
+  EXPECT_EQ(smoothed.coarse.faces, unfolded.coarse.faces);
+  // The truth at the coarse vertices, unsmoothed: the unfolded surface plus the folds.
+  Mesh detailed = unfolded.coarse;
+  detailed.vertices += unfolded.smooth_normals * unfolded.folds_at_coarse.asDiagonal();
+  EXPECT_LT(testing_meshes::Roughness(smoothed.coarse), 0.5 * testing_meshes::Roughness(detailed))
+      << testing_meshes::Roughness(smoothed.coarse) << " vs "
+      << testing_meshes::Roughness(detailed);
+  // Some of the folds stay in the input (30 iterations damp the longest ones little), and what
+  // is gone is in the ground truth: k_true is smaller than for the unfolded input but not zero.
+  const auto rms = [](const Eigen::VectorXd& k) {
+    double squares = 0.0;
+    int count = 0;
+    for (int v = 0; v < k.size(); ++v) {
+      if (std::isnan(k(v))) continue;
+      squares += k(v) * k(v);
+      ++count;
+    }
+    return std::sqrt(squares / count);
+  };
+  EXPECT_GT(rms(smoothed.true_k), 0.0005);
+  EXPECT_LT(rms(smoothed.true_k), rms(unfolded.true_k));
+  // More iterations take more of the detail away.
+  options.smoothing.iterations = 120;
+  const SyntheticFrame stronger = SyntheticCapture(options).Frame(1);
+  EXPECT_GT(rms(stronger.true_k), rms(smoothed.true_k));
+}
+
+TEST(SynthTest, BadSmoothingStrengthIsRefusedNamingTheKey) {
+  SynthOptions options = TinyOptions();
+  options.coarse = CoarseInput::kSmoothed;
+  options.smoothing.iterations = 0;
+  const std::string out = FreshPath("bad_smoothing");
+  try {
+    GenerateSyntheticCapture(options, out);
+    FAIL() << "no error";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("synth.smoothing.iterations"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(SynthTest, MisalignmentMovesOnlyTheCoarseMeshByAFewMillimetres) {

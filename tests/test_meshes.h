@@ -104,6 +104,32 @@ inline Mesh SphereMesh(const Eigen::Vector3d& center, double radius, int rings, 
   return mesh;
 }
 
+// Root mean square over the vertices of the normal part of each vertex's uniform Laplacian (the
+// mean of its neighbours minus the vertex): how bumpy a mesh is at the scale of its edges.
+inline double Roughness(const Mesh& mesh) {
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(mesh);
+  Eigen::Matrix3Xd sum = Eigen::Matrix3Xd::Zero(3, mesh.num_vertices());
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      // An interior edge is seen from both of its triangles, so its neighbours count twice.
+      const int a = mesh.faces(c, f);
+      const int b = mesh.faces((c + 1) % 3, f);
+      sum.col(a) += mesh.vertices.col(b);
+      sum.col(b) += mesh.vertices.col(a);
+      count(a) += 1.0;
+      count(b) += 1.0;
+    }
+  }
+  double squares = 0.0;
+  for (int v = 0; v < mesh.num_vertices(); ++v) {
+    if (count(v) == 0.0) continue;
+    const Eigen::Vector3d laplacian = sum.col(v) / count(v) - mesh.vertices.col(v);
+    squares += std::pow(laplacian.dot(normals.col(v)), 2);
+  }
+  return std::sqrt(squares / mesh.num_vertices());
+}
+
 }  // namespace testing_meshes
 }  // namespace finecap
 

@@ -74,6 +74,13 @@ const std::vector<Subcommand>& Subcommands() {
        " [--capture DIR] [--out DIR]",
        &RunRefine,
        {"config", "capture", "out", "frames", "shard", "solver", "threads", "set"}},
+      {"info",
+       "Show the capture as finecap reads it and what refining it would take (lengths chosen "
+       "from the scene, vertices refined, memory and time per frame), without refining or "
+       "writing anything.",
+       "finecap info --config FILE [--capture DIR] [--frames A:B] [--shard I/N] [--solver ...]",
+       &RunInfo,
+       {"config", "capture", "out", "frames", "shard", "solver", "threads", "set"}},
       {"status",
        "List the configured frames (of one shard with --shard) that a refine output folder "
        "lacks; exit code 0 when none, 3 when some are missing.",

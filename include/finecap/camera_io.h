@@ -84,10 +84,11 @@ std::vector<Camera> ReadCalibToml(const std::string& path);
 // The rig of a capture folder, in this order: cameras.yaml; intri.yml + extri.yml; a Calib.toml
 // (a file whose name, in any case, ends in ".toml" and contains "calib": Calib.toml,
 // Calib_board.toml, calibration.toml, take1_camera_calibration.toml; more than one such file is
-// refused as ambiguous); a COLMAP
-// text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or `capture_dir` itself (the first
-// holding a cameras.txt). Throws Error naming the folder if none is found.
-std::vector<Camera> ReadRig(const std::string& capture_dir);
+// refused as ambiguous); a COLMAP text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or
+// `capture_dir` itself (the first holding a cameras.txt). Throws Error naming the folder if none
+// is found. When `source` is given it receives what the rig was read from, e.g. "cameras.yaml",
+// "intri.yml + extri.yml", "Calib.toml (Pose2Sim/anipose)" or "COLMAP text model in sparse/0".
+std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source = nullptr);
 
 }  // namespace finecap
 

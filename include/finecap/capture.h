@@ -49,6 +49,10 @@ class Capture {
   // The cameras of the images ReadImage returns: the rig's, with distortion zero (images are
   // undistorted on load, same K).
   const std::vector<Camera>& cameras() const { return cameras_; }
+  // The cameras as calibrated, lens distortion included.
+  const std::vector<Camera>& rig() const { return rig_; }
+  // What the rig was read from, e.g. "cameras.yaml" (ReadRig).
+  const std::string& rig_source() const { return rig_source_; }
   int num_cameras() const { return static_cast<int>(cameras_.size()); }
 
   int num_frames() const { return static_cast<int>(frame_names_.size()); }
@@ -95,6 +99,7 @@ class Capture {
   std::string GroundTruthPath(int frame, const std::string& suffix) const;
 
   std::string directory_;
+  std::string rig_source_;
   std::vector<Camera> rig_;      // As calibrated, distortion included.
   std::vector<Camera> cameras_;  // rig_ undistorted.
   std::vector<std::string> frame_names_;

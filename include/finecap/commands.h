@@ -35,6 +35,13 @@ int RunExport(const Config& config);
 // written; a rerun skips the frames already done.
 int RunCompare(const Config& config);
 
+// Prints the capture as finecap reads it (cameras and their format, frames, mesh sizes before and
+// after subdivision, the scene's extent and the lengths chosen from it) and the problem a
+// refinement would solve (vertices refined, pairs, the forecast of peak memory and time per
+// frame, the same as RunRefine prints), with a warning for a camera that sees nothing and for
+// vertices no camera sees within the view-angle cap. Refines nothing and writes nothing.
+int RunInfo(const Config& config);
+
 // Generates a synthetic capture with ground truth (section synth) into output.dir.
 int RunSynth(const Config& config);
 

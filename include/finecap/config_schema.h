@@ -29,6 +29,10 @@ class ConfigSchema {
   void AddDouble(const std::string& path, double* field, const std::string& doc,
                  double min = std::numeric_limits<double>::lowest(),
                  double max = std::numeric_limits<double>::max());
+  // A number in [min, max] or the word "auto": a number sets `*field` and clears `*is_auto`,
+  // "auto" sets `*is_auto` (and leaves `*field`). Prints as "auto" while `*is_auto` is set.
+  void AddDoubleOrAuto(const std::string& path, double* field, bool* is_auto,
+                       const std::string& doc, double min, double max);
   void AddBool(const std::string& path, bool* field, const std::string& doc);
   void AddString(const std::string& path, std::string* field, const std::string& doc);
   void AddChoice(const std::string& path, std::string* field, const std::string& doc,

@@ -24,7 +24,8 @@ struct EnergyOptions {
   // A pair of Gaussians is evaluated when their means are less than this many combined standard
   // deviations sqrt(sigma_s^2 + sigma_i^2) apart for some allowed k. Default 3.
   double reach_sigmas = 3.0;
-  // Bound on the displacement |k| along the normal, metres. Default 0.02.
+  // Bound on the displacement |k| along the normal, metres. Default 0.02; a refinement makes it
+  // follow from the scene unless set (RefineOptions::scene_lengths).
   double k_max = 0.02;
   // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg, and its
   // E_sim). Default 1e-7, for the surface-colour similarity, whose residuals are colour

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "finecap/energy_options.h"
+#include "finecap/gaussian_pairs.h"
 #include "finecap/neighbourhood.h"
 #include "finecap/regularizer.h"
 #include "finecap/similarity.h"
@@ -26,6 +27,9 @@ struct CameraInput {
   const ImageGaussians* image = nullptr;
   std::vector<unsigned char> visible;
 };
+
+// The options of the pair lists the energy builds with `options` (gaussian_pairs.h).
+PairOptions EnergyPairOptions(const EnergyOptions& options);
 
 class FrameEnergy {
  public:

@@ -40,6 +40,13 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
                              const SurfaceGaussians& surface,
                              const std::vector<unsigned char>& visible, const PairOptions& options);
 
+// The number of pairs BuildCameraPairs would make, from the pairs of every `stride`-th visible
+// surface Gaussian scaled to all of them (stride 1: exact), without keeping any: what a frame's
+// pair lists will weigh, known before they are built.
+double CountCameraPairs(const Camera& camera, const ImageGaussians& image,
+                        const SurfaceGaussians& surface, const std::vector<unsigned char>& visible,
+                        const PairOptions& options, int stride);
+
 }  // namespace finecap
 
 #endif  // FINECAP_GAUSSIAN_PAIRS_H_

@@ -50,11 +50,24 @@ struct CoarseToFineOptions {
   void Check() const;
 };
 
+// Which lengths of RefineOptions follow from the scene's scale (scene_scale.h) instead of the
+// values their fields hold. Until ResolveSceneScaleDefaults replaces it, a marked field holds the
+// person-sized value finecap used before it measured the scene, and that is what RefineFrame
+// uses; a caller who sets such a length clears its mark. Default: every length follows the scene.
+struct SceneLengths {
+  bool sigma_hat = true;        // RefineOptions::sigma_hat (model.sigma_hat).
+  bool k_max = true;            // energy.k_max.
+  bool depth_tolerance = true;  // visibility.depth_tolerance.
+  bool initial_step = true;     // solver.initial_step.
+  bool max_step = true;         // solver.max_step.
+};
+
 struct RefineOptions {
   // Loop subdivision levels applied to the coarse mesh before refinement (the paper subdivided
   // its 1.5k-2.5k-vertex meshes to 6k-10k vertices: 1 level). Default 1.
   int subdivision_levels = 1;
-  // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007.
+  // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007. Follows from
+  // the scene unless set (scene_lengths).
   double sigma_hat = 0.007;
   // How the reference frame colours the surface Gaussians: "pixels" (the paper: the mean of the
   // pixels under the projected Gaussian in the best-aligned camera) or "image_model" (in that
@@ -83,6 +96,8 @@ struct RefineOptions {
   VisibilityOptions visibility;
   EnergyOptions energy;
   SolverOptions solver;
+  // The lengths above that are still to follow from the scene.
+  SceneLengths scene_lengths;
 
   void Check() const;
 };

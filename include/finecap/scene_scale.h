@@ -1,16 +1,97 @@
-// A guard against captures in the wrong unit. finecap's lengths are metres (sigma_hat, k_max, the
-// depth tolerance, the synthetic folds), so a capture in millimetres or centimetres would not fail
-// anywhere: its Gaussians would simply be 1000 or 100 times too small to see anything, and the
-// refinement would silently do nothing useful. The size of the coarse mesh against sigma_hat
-// tells the units apart: a performer in metres spans a few hundred sigma_hat.
+// The scale of a capture, and the lengths that follow from it.
+//
+// The refinement's lengths (sigma_hat, k_max, the depth tolerance of the visibility test, the
+// gradient ascent's steps) only make sense relative to the subject: 7 mm Gaussians suit a person
+// meshed with 10k vertices and filmed from 3 m, not a 10 cm figurine. Unless a config sets them,
+// they follow from one scene length measured on the reference frame (MeasureSceneScale):
+//
+//   scene length s = max(mean edge length of the subdivided mesh, 3 * pixel footprint),
+//
+// the pixel footprint being the median, over the cameras and the fine vertices each sees in its
+// image, of depth / focal length (the metres one pixel covers at the surface). The edge length
+// says how densely surface Gaussians sample the surface; the footprint floor keeps a Gaussian
+// wide enough (about 2 pixels) for the image model to see. Each length is a fixed multiple of s
+// (SceneLengthFactors), chosen so that the person-sized presets keep the values finecap used
+// before it measured the scene (sigma_hat 7 mm, k_max 2 cm: synth_skirt's s is 11.4 mm).
+//
+// Also a guard against captures in the wrong unit. finecap's lengths are metres (its outputs,
+// the synthetic folds), so a capture in millimetres or centimetres would not fail anywhere: with
+// lengths set in metres its Gaussians would simply be 1000 or 100 times too small to see
+// anything. The size of the coarse mesh against sigma_hat tells the units apart: a performer in
+// metres spans a few hundred sigma_hat. (Lengths that follow from the scene would fit a capture in
+// millimetres too, but its outputs would not be metres; the commands measure the mesh against
+// the person-sized 7 mm then, so such a capture is still refused.)
 #ifndef FINECAP_SCENE_SCALE_H_
 #define FINECAP_SCENE_SCALE_H_
 
 #include <string>
+#include <vector>
 
+#include "finecap/camera.h"
 #include "finecap/mesh.h"
+#include "finecap/refine.h"
 
 namespace finecap {
+
+class Capture;
+
+// What MeasureSceneScale measures, in the capture's units (metres).
+struct SceneScale {
+  double diagonal = 0.0;          // Bounding-box diagonal of the mesh.
+  double mean_edge_length = 0.0;  // Mean edge length of the subdivided mesh.
+  // Median over (camera, fine vertex in front of it and inside its image) of depth / focal
+  // length; 0 when no camera sees any vertex.
+  double pixel_footprint = 0.0;
+  // max(mean_edge_length, kFootprintsPerSceneLength * pixel_footprint).
+  double length = 0.0;
+};
+
+// The scene length is never less than this many pixel footprints.
+constexpr double kFootprintsPerSceneLength = 3.0;
+
+// Each length that follows from the scene, as a multiple of the scene length s.
+struct SceneLengthFactors {
+  double sigma_hat = 0.6;        // 6.8 mm on synth_skirt (s = 11.4 mm), 0.71 mm on the temple.
+  double k_max = 1.75;           // 20 mm; 2.1 mm.
+  double depth_tolerance = 0.9;  // 10 mm; 1.1 mm.
+  double initial_step = 0.045;   // 0.51 mm; 0.054 mm.
+  double max_step = 0.175;       // 2.0 mm; 0.21 mm.
+};
+
+// Measures `fine` (a subdivided mesh) as seen by `cameras`.
+SceneScale MeasureSceneScale(const Mesh& fine, const std::vector<Camera>& cameras);
+
+// One length of RefineOptions as a run uses it.
+struct ChosenLength {
+  std::string key;          // Its config key, e.g. "model.sigma_hat".
+  double value = 0.0;       // Metres.
+  bool from_scene = false;  // Followed from the scene (else set explicitly).
+};
+
+struct SceneScaleDefaults {
+  SceneScale scale;
+  std::vector<ChosenLength> lengths;  // Every length of RefineOptions::scene_lengths' kind.
+};
+
+// Fills in every length of `*options` that `options->scene_lengths` marks as following from the
+// scene; lengths set explicitly stay. The marks stay too, so resolving again (on the same scene)
+// changes nothing. `reference_coarse` is the coarse
+// mesh of the reference frame, subdivided here with options->subdivision_levels; `where` names it
+// in errors. Returns what was measured and every length as chosen.
+SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
+                                             const std::vector<Camera>& cameras,
+                                             const std::string& where, RefineOptions* options);
+
+// The same for a capture's frame `reference_frame` (an index into its sorted frame list).
+SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int reference_frame,
+                                             RefineOptions* options);
+
+// A length for people: "0.716 mm", "207 mm", "1.18 m".
+std::string LengthText(double metres);
+
+// A line that says what was chosen and from what, e.g. "scene length 9.9 mm (mean edge 9.9 mm,
+// pixel footprint 3.0 mm); model.sigma_hat 6.93 mm (from the scene), energy.k_max 20 mm (set)".
+std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults);
 
 struct SceneScaleLimits {
   // The smallest bounding-box diagonal of a coarse mesh accepted, in multiples of sigma_hat.

@@ -40,7 +40,8 @@ struct SolverOptions {
   std::string linear_solver = "sparse_normal_cholesky";
 
   // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
-  // are scaled from it). Default 0.5 mm.
+  // are scaled from it). Default 0.5 mm; a refinement makes it follow from the scene unless set
+  // (RefineOptions::scene_lengths), as max_step.
   double initial_step = 0.0005;
   // Gradient ascent only: step factor growth when a derivative keeps its sign, and shrink when
   // it flips. Defaults 1.2 and 0.5.

@@ -7,7 +7,8 @@
 //
 //   cameras.yaml                  the rig as calibrated (calibration noise applied)
 //   images/<camera>/<frame>.png   8-bit colour images, distorted with the rig's lens distortion
-//   meshes/<frame>.ply            coarse input mesh: the true surface without its folds
+//   meshes/<frame>.ply            coarse input mesh: the true surface without its folds, or a
+//                                 smoothed copy of it (SynthOptions::coarse)
 //   gt/<frame>.ply                the true (finer) surface
 //   gt/<frame>_k.txt              per coarse vertex: signed distance along its (area-weighted)
 //                                 coarse normal to the true surface, metres; "nan" on a miss
@@ -28,6 +29,7 @@
 
 #include "finecap/camera.h"
 #include "finecap/mesh.h"
+#include "finecap/mesh_smoothing.h"
 #include "finecap/render.h"
 
 namespace finecap {
@@ -139,6 +141,20 @@ struct RigOptions {
   void Check() const;
 };
 
+// What the coarse input meshes of a synthetic capture are.
+enum class CoarseInput {
+  // The true surface without its folds: the smooth surface the folds are added to, exact where
+  // there are none (a template tracker that got everything but the folds right).
+  kUnfolded,
+  // The true surface at the coarse vertices (each coarse vertex is a vertex of the true mesh),
+  // Taubin-smoothed over the coarse mesh: a smoothed copy of the true surface, as in the paper's
+  // smoothed-input experiment. What smoothing leaves of the detail stays in the input, and the
+  // input differs from the truth everywhere a little, as a real one does. With a detailed user
+  // mesh sequence as the subject (truth_refinement 1, no folds) it is the sequence itself that
+  // the coarse meshes smooth.
+  kSmoothed,
+};
+
 struct SynthOptions {
   // "skirt" (the built-in flared tube, see `skirt`) or "mesh" (the meshes at `mesh_path`).
   // Default "skirt".
@@ -146,8 +162,9 @@ struct SynthOptions {
   SkirtOptions skirt;
   // For subject "mesh": a mesh file (the subject stands still) or a folder of per-frame meshes
   // sharing one topology, taken in name order (.ply, .obj, .off, .stl). World y must point up.
-  // Each frame's mesh is the coarse input; the true surface is its midpoint subdivision with
-  // folds added along interpolated normals. Default empty.
+  // The true surface is each frame's midpoint subdivision with folds added along interpolated
+  // normals (truth_refinement 1 and no folds: the mesh itself); the coarse input is the mesh
+  // itself, or its smoothed copy (see `coarse`). Default empty.
   std::string mesh_path;
   // Number of frames (>= 1; at most the number of meshes in a `mesh_path` folder). Default 5.
   int num_frames = 5;
@@ -164,9 +181,17 @@ struct SynthOptions {
   };
   // When > 0, every fold gets this wavelength (metres): captures with one fold scale. Default 0.
   double single_wavelength = 0.0;
-  // Fold amplitudes grow smoothly from zero at frame 0 (the smooth reference pose) to full at
-  // this frame; 0 gives full folds from frame 0. Default 3.
-  int fold_ramp_frames = 3;
+  // Fold amplitudes grow smoothly from zero at frame 0 to full at this frame; 0 gives full folds
+  // from frame 0. With a ramp the reference frame (frame 0, whose images colour the surface) has
+  // an exact coarse mesh, which a real capture never has: it flatters the refinement, and is kept
+  // for comparison (configs/synth_skirt_ramp.yaml). Default 0.
+  int fold_ramp_frames = 0;
+
+  // What the coarse meshes are (see CoarseInput). Default kUnfolded.
+  CoarseInput coarse = CoarseInput::kUnfolded;
+  // The smoothing of the coarse meshes when `coarse` is kSmoothed (its iterations are the
+  // strength). Default: 30 iterations, lambda 0.5, mu -0.5025.
+  TaubinSmoothingOptions smoothing;
 
   // Peak of a smooth random displacement field (3D, fixed to the material) added to the coarse
   // meshes: the input's low-frequency misalignment, metres. Default 0.
@@ -196,12 +221,14 @@ struct SynthOptions {
 
 // The ground truth of one frame, in memory.
 struct SyntheticFrame {
-  Mesh coarse;  // The input mesh: the unfolded surface, misaligned when asked.
+  Mesh coarse;  // The input mesh: unfolded or smoothed (SynthOptions::coarse), misaligned when
+                // asked.
   Mesh truth;   // The true, finer surface.
   // Per coarse vertex: signed distance along its coarse normal to `truth`; NaN on a miss.
   Eigen::VectorXd true_k;
   // Per coarse vertex: the fold displacement at its material point, metres, applied along
-  // `smooth_normals` (what true_k measures when the coarse and smooth normals agree).
+  // `smooth_normals` (what true_k measures when the coarse input is unfolded and the coarse and
+  // smooth normals agree).
   Eigen::VectorXd folds_at_coarse;
   // Per coarse vertex: unit normal of the smooth (unfolded) surface.
   Eigen::Matrix3Xd smooth_normals;

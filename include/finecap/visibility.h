@@ -15,7 +15,8 @@ namespace finecap {
 
 struct VisibilityOptions {
   // A point is occluded when it lies more than this behind the rendered surface, metres.
-  // Default 0.01: the input mesh is coarse, folds move the true surface by up to ~2 cm.
+  // Default 0.01: the input mesh is coarse, folds move the true surface by up to ~2 cm. A
+  // refinement makes it follow from the scene unless set (RefineOptions::scene_lengths).
   double depth_tolerance = 0.01;
   // Largest angle between the normal and the direction to the camera, degrees; beyond it the
   // point is back-facing or seen so obliquely that folds hide parts of it and a small k moves its

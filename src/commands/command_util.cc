@@ -32,6 +32,45 @@ FrameRange ConfiguredFrames(const Config& config, const Capture& capture) {
   return range;
 }
 
+Config WithSceneLengths(const Config& config, const Capture& capture, const std::string& command,
+                        SceneScaleDefaults* defaults) {
+  // A sigma_hat that follows from the scene fits any mesh, so the unit check measures the mesh
+  // against the person-sized value: a capture in millimetres is still told apart.
+  const double unit_check_sigma_hat =
+      config.refine.scene_lengths.sigma_hat ? RefineOptions().sigma_hat : config.refine.sigma_hat;
+  RequirePlausibleSceneScale(capture.ReadCoarseMesh(0), unit_check_sigma_hat, capture.mesh_path(0));
+  Config resolved = config;
+  const SceneScaleDefaults chosen =
+      ResolveSceneScaleDefaults(capture, config.reference_frame, &resolved.refine);
+  std::cerr << "finecap " << command << ": " << DescribeSceneScaleDefaults(chosen) << "\n";
+  if (defaults != nullptr) *defaults = chosen;
+  resolved.refine.Check();
+  return resolved;
+}
+
+std::string RoundedCount(double count) {
+  std::ostringstream text;
+  if (count >= 1e6) {
+    text.precision(count >= 1e7 ? 0 : 1);
+    text << std::fixed << count / 1e6 << " M";
+  } else {
+    text << std::lround(count);
+  }
+  return text.str();
+}
+
+std::string RoundedSeconds(double seconds) {
+  std::ostringstream text;
+  text.precision(seconds < 10.0 || (seconds >= 60.0 && seconds < 600.0) ? 1 : 0);
+  text << std::fixed;
+  if (seconds < 60.0) {
+    text << seconds << " s";
+  } else {
+    text << seconds / 60.0 << " min";
+  }
+  return text.str();
+}
+
 std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
   Require(!config.output.dir.empty(), "output.dir",
           "no output folder given (set output.dir or pass --out DIR)");
@@ -89,8 +128,10 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
   if (fs::exists(path)) {
     ReferenceColors saved = ReadReferenceColors(path, model.num_fine_vertices());
     const RefineOptions& options = config.refine;
+    // The file holds sigma_hat to 9 significant digits, which a length chosen from the scene
+    // needs all of.
     Require(saved.color_space == options.image.color_space &&
-                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-12 * options.sigma_hat &&
+                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-8 * options.sigma_hat &&
                 saved.method == options.reference_colors,
             path,
             "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +

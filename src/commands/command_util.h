@@ -10,6 +10,7 @@
 #include "finecap/capture.h"
 #include "finecap/config.h"
 #include "finecap/refine.h"
+#include "finecap/scene_scale.h"
 
 namespace finecap {
 namespace internal {
@@ -26,6 +27,19 @@ std::string PrepareOutputFolder(const Config& config, const Capture& capture);
 
 // output.dir of a previous `finecap refine`, which must exist (nothing is created).
 std::string RefinedRunFolder(const Config& config);
+
+// `config` with the lengths that follow from the scene chosen (ResolveSceneScaleDefaults on the
+// configured reference frame), and a line on stderr, "finecap <command>: scene length ...", that
+// says what they are and from what. Then checks that the mesh's size fits sigma_hat (metres, not
+// millimetres: RequirePlausibleSceneScale), against the person-sized 7 mm when sigma_hat follows
+// from the scene. `defaults` (may be null) receives what was measured and chosen.
+Config WithSceneLengths(const Config& config, const Capture& capture, const std::string& command,
+                        SceneScaleDefaults* defaults = nullptr);
+
+// A count for people: "8100", "1.2 M", "85 M".
+std::string RoundedCount(double count);
+// A duration for people: "0.8 s", "12 s", "3.5 min".
+std::string RoundedSeconds(double seconds);
 
 // The coarse mesh, cameras and undistorted images of one frame.
 FrameInput ReadFrameInput(Capture* capture, int frame);

@@ -167,11 +167,14 @@ void WriteReport(const std::vector<Variant>& variants, const std::vector<Variant
 }  // namespace
 
 int RunCompare(const Config& config) {
-  const std::vector<Variant> checked = VariantConfigs(config);
+  std::vector<Variant> variants = VariantConfigs(config);
   Capture capture = internal::OpenConfiguredCapture(config);
   const FrameRange frames = internal::ConfiguredFrames(config, capture);
+  for (Variant& variant : variants) {
+    variant.config =
+        internal::WithSceneLengths(variant.config, capture, "compare, " + variant.spec.name);
+  }
   const std::string out = internal::PrepareOutputFolder(config, capture);
-  std::vector<Variant> variants = checked;
   for (Variant& variant : variants) variant.config.output.dir = out + "/" + variant.spec.name;
 
   std::vector<VariantSummary> rows;

@@ -409,8 +409,9 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
 
 }  // namespace
 
-int RunEval(const Config& config) {
-  Capture capture = internal::OpenConfiguredCapture(config);
+int RunEval(const Config& configured) {
+  Capture capture = internal::OpenConfiguredCapture(configured);
+  const Config config = internal::WithSceneLengths(configured, capture, "eval");
   const std::string out = internal::RefinedRunFolder(config);
   Require(config.eval.camera < capture.num_cameras(), "eval.camera",
           std::to_string(config.eval.camera) + " is not a camera of " + capture.directory() +

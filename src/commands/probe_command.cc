@@ -59,8 +59,9 @@ std::string ProbeOutputFolder(const Config& config, const Capture& capture) {
 
 }  // namespace
 
-int RunProbe(const Config& config, int frame_index) {
-  Capture capture = internal::OpenConfiguredCapture(config);
+int RunProbe(const Config& configured, int frame_index) {
+  Capture capture = internal::OpenConfiguredCapture(configured);
+  const Config config = internal::WithSceneLengths(configured, capture, "probe");
   const int frame = frame_index >= 0 ? frame_index : capture.num_frames() - 1;
   Require(frame < capture.num_frames(), "--frame",
           "frame " + std::to_string(frame) + " does not exist in " + capture.directory());

@@ -1,5 +1,6 @@
 // finecap refine: every configured frame of a capture, refined and written to output.dir.
 #include <charconv>
+#include <cmath>
 #include <iostream>
 #include <sstream>
 
@@ -11,7 +12,7 @@
 #include "finecap/frame_stats.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
-#include "finecap/scene_scale.h"
+#include "finecap/problem_size.h"
 #include "finecap/shard.h"
 #include "finecap/solver_trace.h"
 
@@ -78,30 +79,28 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
       1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
 }
 
-void PrintProblemSize(const Capture& capture, const SequenceModel& model, int frames) {
-  const Camera& camera = capture.cameras().front();
-  const double pixels = double(camera.width) * camera.height * capture.num_cameras();
-  // Images (8-bit and converted float), image Gaussians (~1 per 16 pixels), pair lists
-  // (~40 pairs per visible surface Gaussian and camera, ~half the cameras see a vertex).
-  const double megabytes =
-      (pixels * (3 + 12 + 24.0 / 16) +
-       model.refined_vertices().size() * capture.num_cameras() * 0.5 * 40 * 8.0) /
-      1e6;
-  std::cerr << "finecap refine: " << frames << " frames, " << capture.num_cameras()
+// The size of the first frame's problem and what it forecasts, before the long part of the run.
+void PrintProblemSize(const Config& config, const SequenceModel& model,
+                      const ReferenceColors& colors, Capture* capture, int first_frame,
+                      int frames) {
+  const ProblemSize size = EstimateProblemSize(
+      model, colors, internal::ReadFrameInput(capture, first_frame), config.refine);
+  const Camera& camera = capture->cameras().front();
+  std::cerr << "finecap refine: " << frames << " frames, " << capture->num_cameras()
             << " cameras of " << camera.width << "x" << camera.height << ", "
-            << model.refined_vertices().size() << " surface Gaussians (of "
-            << model.num_fine_vertices() << " vertices after subdivision); expected peak memory "
-            << static_cast<long>(megabytes + 100) << " MB\n";
+            << size.num_surface_gaussians << " surface Gaussians (of " << size.num_fine_vertices
+            << " vertices after subdivision), about " << internal::RoundedCount(size.num_pairs)
+            << " pairs; expected peak memory " << std::lround(size.peak_memory_mb) << " MB, about "
+            << internal::RoundedSeconds(size.seconds_per_frame) << " per frame\n";
 }
 
 }  // namespace
 
-int RunRefine(const Config& config) {
-  Capture capture = internal::OpenConfiguredCapture(config);
+int RunRefine(const Config& configured) {
+  Capture capture = internal::OpenConfiguredCapture(configured);
   const FrameRange frames =
-      ShardOf(internal::ConfiguredFrames(config, capture), config.runtime.shard);
-  RequirePlausibleSceneScale(capture.ReadCoarseMesh(0), config.refine.sigma_hat,
-                             capture.mesh_path(0));
+      ShardOf(internal::ConfiguredFrames(configured, capture), configured.runtime.shard);
+  const Config config = internal::WithSceneLengths(configured, capture, "refine");
   const std::string out = internal::PrepareOutputFolder(config, capture);
   const int stale = internal::PrepareRunSubfolders(out);
   if (stale > 0) std::cerr << "finecap refine: removed " << stale << " files a killed run left\n";
@@ -118,7 +117,7 @@ int RunRefine(const Config& config) {
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
   const Regions regions = SplitByTexture(model, capture);
-  PrintProblemSize(capture, model, frames.size());
+  PrintProblemSize(config, model, colors, &capture, frames.begin, frames.size());
 
   internal::Progress progress(frames.size());
   double sum_coarse2 = 0.0, sum_refined2 = 0.0;

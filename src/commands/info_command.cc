@@ -1,0 +1,102 @@
+// finecap info: the capture as finecap reads it and the problem a refinement would solve, without
+// refining or writing anything. Every figure comes from the library functions a run uses.
+#include <cmath>
+#include <iostream>
+
+#include "commands/command_util.h"
+#include "finecap/commands.h"
+#include "finecap/problem_size.h"
+#include "finecap/scene_scale.h"
+#include "finecap/shard.h"
+
+namespace finecap {
+namespace {
+
+void PrintCameras(const Capture& capture, const ProblemSize& size) {
+  std::cout << "cameras: " << capture.num_cameras() << ", read from " << capture.rig_source()
+            << "\n";
+  for (int c = 0; c < capture.num_cameras(); ++c) {
+    const Camera& camera = capture.rig()[c];
+    std::cout << "  " << camera.name << ": " << camera.width << "x" << camera.height << ", focal "
+              << camera.focal() << " px"
+              << (camera.HasDistortion() ? ", lens distortion (undistorted on load)" : "")
+              << ", sees " << size.visible_per_camera[c] << " fine vertices\n";
+  }
+}
+
+void PrintFrames(const Capture& capture, const FrameRange& frames, int reference_frame) {
+  std::cout << "frames: " << capture.num_frames() << " (" << capture.frame_name(0) << " .. "
+            << capture.frame_name(capture.num_frames() - 1) << "), " << frames.size()
+            << " to refine (" << frames.begin << ":" << frames.end << "), reference frame "
+            << capture.frame_name(reference_frame) << "\n";
+}
+
+void PrintWarnings(const Config& config, const Capture& capture, const ProblemSize& size) {
+  for (int c = 0; c < capture.num_cameras(); ++c) {
+    if (size.visible_per_camera[c] > 0) continue;
+    std::cout << "warning: camera " << capture.cameras()[c].name
+              << " sees no vertex of the mesh (behind it, out of its image, or every vertex "
+                 "beyond the view-angle cap): check its calibration and units\n";
+  }
+  if (size.num_unseen_refined_vertices > 0) {
+    std::cout << "warning: " << size.num_unseen_refined_vertices << " of "
+              << size.num_refined_vertices
+              << " vertices to refine are seen by no camera within visibility.max_view_angle_deg "
+              << config.refine.visibility.max_view_angle_deg
+              << " degrees; they keep the input surface\n";
+  }
+}
+
+}  // namespace
+
+int RunInfo(const Config& configured) {
+  Capture capture = internal::OpenConfiguredCapture(configured);
+  const FrameRange frames =
+      ShardOf(internal::ConfiguredFrames(configured, capture), configured.runtime.shard);
+  SceneScaleDefaults defaults;
+  const Config config = internal::WithSceneLengths(configured, capture, "info", &defaults);
+
+  const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
+                            capture.mesh_path(0));
+  const ReferenceColors colors = ComputeSequenceColors(
+      model, internal::ReadFrameInput(&capture, config.reference_frame), config.refine);
+  const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
+  const ProblemSize size =
+      EstimateProblemSize(model, colors, internal::ReadFrameInput(&capture, first), config.refine);
+
+  std::cout << "capture: " << capture.directory() << "\n";
+  PrintCameras(capture, size);
+  PrintFrames(capture, frames, config.reference_frame);
+  const Mesh coarse = capture.ReadCoarseMesh(0);
+  std::cout << "mesh: " << coarse.num_vertices() << " vertices, " << coarse.num_faces()
+            << " faces; " << size.num_fine_vertices << " vertices after "
+            << config.refine.subdivision_levels << " subdivision level(s)\n";
+  const SceneScale& scale = defaults.scale;
+  std::cout << "scene: extent " << LengthText(scale.diagonal)
+            << " (bounding-box diagonal), mean edge after subdivision "
+            << LengthText(scale.mean_edge_length) << ", pixel footprint "
+            << LengthText(scale.pixel_footprint) << ", scene length " << LengthText(scale.length)
+            << "\n";
+  std::cout << "lengths:";
+  for (size_t i = 0; i < defaults.lengths.size(); ++i) {
+    const ChosenLength& length = defaults.lengths[i];
+    std::cout << (i ? ", " : " ") << length.key << " " << LengthText(length.value)
+              << (length.from_scene ? " (auto)" : " (set)");
+  }
+  std::cout << "\n";
+  std::cout << "vertices refined: " << size.num_surface_gaussians << " of "
+            << size.num_refined_vertices << " to refine ("
+            << (capture.has_vertex_mask() ? "mask.txt" : "no mask: all") << "), "
+            << size.num_unseen_refined_vertices << " seen by no camera\n";
+  std::cout << "problem per frame: " << size.num_image_gaussians << " image Gaussians, about "
+            << internal::RoundedCount(size.num_pairs) << " pairs of Gaussians, "
+            << size.num_observations << " observations\n";
+  std::cout << "forecast per frame: peak memory " << std::lround(size.peak_memory_mb)
+            << " MB, about " << internal::RoundedSeconds(size.seconds_per_frame) << " ("
+            << internal::RoundedSeconds(size.seconds_per_frame * frames.size()) << " for "
+            << frames.size() << " frames)\n";
+  PrintWarnings(config, capture, size);
+  return 0;
+}
+
+}  // namespace finecap

@@ -1,0 +1,102 @@
+// What a frame's refinement will take, known before the work: the pair count is that of the
+// pair lists the energy builds, and the forecast follows the problem's size.
+#include "finecap/problem_size.h"
+
+#include <gtest/gtest.h>
+
+#include "energy_fixture.h"
+#include "finecap/capture.h"
+#include "finecap/frame_energy.h"
+#include "finecap/gaussian_pairs.h"
+#include "finecap/scene_scale.h"
+#include "finecap/synth.h"
+#include "test_util.h"
+#include "tiny_synth.h"
+
+namespace finecap {
+namespace {
+
+TEST(CountCameraPairs, CountsThePairsBuildCameraPairsMakes) {
+  const EnergyScene scene = MakeEnergyScene({0.0, 0.4}, 12, 7);
+  for (const double cutoff : {0.0, 0.05}) {
+    PairOptions options;
+    options.k_max = 0.01;
+    options.color_cutoff = cutoff;
+    for (const CameraInput& camera : scene.cameras) {
+      const CameraPairs pairs =
+          BuildCameraPairs(camera.camera, *camera.image, scene.surface, camera.visible, options);
+      ASSERT_GT(pairs.num_pairs(), 0);
+      EXPECT_EQ(
+          CountCameraPairs(camera.camera, *camera.image, scene.surface, camera.visible, options, 1),
+          pairs.num_pairs());
+      // Every 3rd surface Gaussian, scaled: close, not exact.
+      EXPECT_NEAR(
+          CountCameraPairs(camera.camera, *camera.image, scene.surface, camera.visible, options, 3),
+          pairs.num_pairs(), 0.2 * pairs.num_pairs());
+    }
+  }
+}
+
+class ProblemSizeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string dir = testing_util::MakeTempDir("problem_size") + "/capture";
+    GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(1), dir);
+    Capture capture = Capture::Open(dir);
+    input_.coarse = capture.ReadCoarseMesh(0);
+    input_.cameras = capture.cameras();
+    for (int c = 0; c < capture.num_cameras(); ++c)
+      input_.images.push_back(capture.ReadImage(c, 0));
+    ResolveSceneScaleDefaults(input_.coarse, input_.cameras, "tiny", &options_);
+  }
+
+  ProblemSize Estimate(const RefineOptions& options, PreparedFrame* prepared) const {
+    const SequenceModel model(input_.coarse, {}, options, "tiny");
+    const ReferenceColors colors = ComputeSequenceColors(model, input_, options);
+    *prepared = PrepareFrame(model, colors, input_, options);
+    return EstimateProblemSize(model, colors, input_, options);
+  }
+
+  FrameInput input_;
+  RefineOptions options_;
+};
+
+TEST_F(ProblemSizeTest, SizesAreThoseOfThePreparedFrame) {
+  PreparedFrame prepared;
+  const ProblemSize size = Estimate(options_, &prepared);
+  EXPECT_EQ(size.num_fine_vertices, prepared.fine.num_vertices());
+  EXPECT_EQ(size.num_refined_vertices, prepared.fine.num_vertices());
+  EXPECT_EQ(size.num_surface_gaussians, prepared.energy->num_parameters());
+  EXPECT_EQ(size.num_image_gaussians, prepared.num_image_gaussians);
+  // Fewer than 3000 surface Gaussians per camera: every one is counted.
+  EXPECT_EQ(size.num_pairs, prepared.energy->num_pairs());
+  ASSERT_EQ(size.visible_per_camera.size(), input_.cameras.size());
+  for (int seen : size.visible_per_camera) EXPECT_GT(seen, 0);
+  EXPECT_EQ(size.num_pixels, 3.0 * 96 * 96);
+  EXPECT_GT(size.peak_memory_mb, 0.0);
+  EXPECT_GT(size.seconds_per_frame, 0.0);
+}
+
+TEST_F(ProblemSizeTest, MoreReachMeansMorePairsAndMoreMemory) {
+  PreparedFrame prepared;
+  const ProblemSize size = Estimate(options_, &prepared);
+  RefineOptions wider = options_;
+  wider.energy.k_max *= 3.0;
+  const ProblemSize wide = Estimate(wider, &prepared);
+  EXPECT_GT(wide.num_pairs, size.num_pairs);
+  EXPECT_GT(wide.peak_memory_mb, size.peak_memory_mb);
+  EXPECT_GT(wide.seconds_per_frame, size.seconds_per_frame);
+}
+
+TEST_F(ProblemSizeTest, VerticesNoCameraSeesAreCounted) {
+  RefineOptions narrow = options_;
+  narrow.visibility.max_view_angle_deg = 1.0;
+  PreparedFrame prepared;
+  const ProblemSize size = Estimate(narrow, &prepared);
+  EXPECT_GT(size.num_unseen_refined_vertices, 0);
+  EXPECT_EQ(size.num_surface_gaussians + size.num_unseen_refined_vertices,
+            size.num_refined_vertices);
+}
+
+}  // namespace
+}  // namespace finecap
