@@ -1,6 +1,7 @@
 // finecap refine: every configured frame of a capture, refined and written to output.dir.
 #include <charconv>
 #include <cmath>
+#include <future>
 #include <iostream>
 #include <sstream>
 
@@ -122,6 +123,53 @@ void PrintProblemSize(const Config& config, const SequenceModel& model,
             << internal::RoundedSeconds(size.seconds_per_frame) << " per frame\n";
 }
 
+// Reads frames' inputs (the coarse mesh, every camera's image decoded and undistorted) one frame
+// ahead on a thread of its own, so that reading the next frame overlaps solving this one and both
+// cores stay busy. Only this reader reads images from the capture while it lives; at most one
+// frame is read ahead (bounded memory).
+class FrameReader {
+ public:
+  FrameReader(Capture* capture, bool skip_unreadable)
+      : capture_(capture), skip_unreadable_(skip_unreadable) {}
+
+  // Starts reading `frame` in the background (after any read still under way).
+  void ReadAhead(int frame) {
+    if (pending_.valid()) return;
+    pending_frame_ = frame;
+    pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+  }
+
+  // The input of `frame`: the one read ahead when it is that frame (its errors are thrown here),
+  // else read now. The cameras skipped go to *skipped.
+  FrameInput Take(int frame, std::vector<std::string>* skipped) {
+    if (pending_.valid() && pending_frame_ == frame) {
+      Frame read = pending_.get();
+      *skipped = std::move(read.skipped);
+      return std::move(read.input);
+    }
+    pending_ = {};  // Waits for a read of another frame, and drops it.
+    Frame read = Read(frame);
+    *skipped = std::move(read.skipped);
+    return std::move(read.input);
+  }
+
+ private:
+  struct Frame {
+    FrameInput input;
+    std::vector<std::string> skipped;
+  };
+  Frame Read(int frame) {
+    Frame read;
+    read.input = internal::ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
+    return read;
+  }
+
+  Capture* capture_;
+  bool skip_unreadable_;
+  int pending_frame_ = -1;
+  std::future<Frame> pending_;
+};
+
 }  // namespace
 
 int RunRefine(const Config& configured) {
@@ -148,6 +196,7 @@ int RunRefine(const Config& configured) {
   PrintProblemSize(config, model, colors, &capture, frames.begin, frames.size());
 
   internal::Progress progress(frames.size());
+  FrameReader reader(&capture, config.capture.skip_unreadable_cameras);
   double sum_coarse2 = 0.0, sum_refined2 = 0.0;
   int measured = 0;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
@@ -159,9 +208,16 @@ int RunRefine(const Config& configured) {
     }
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> skipped;
-    FrameInput input =
-        internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
+    FrameInput input = reader.Take(frame, &skipped);
     const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
+    for (int next = frame + 1; next < frames.end; ++next) {
+      if (internal::FrameDone(
+              internal::FrameFilesIn(out, capture.frame_name(next), config.output.mesh_format))) {
+        continue;
+      }
+      reader.ReadAhead(next);
+      break;
+    }
     const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
     FrameResult result = warm_start.size() > 0
                              ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
