@@ -1,6 +1,7 @@
 // One evaluation of the energy and its gradient on a synth_skirt frame (10k surface Gaussians,
 // 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads; and the
-// preparation of a frame (subdivision, visibility, image Gaussians, pair lists).
+// preparation of a frame (subdivision, visibility, image Gaussians, pair lists); and reading a
+// frame's input (the coarse mesh and every camera's image, decoded and undistorted).
 //
 //   build/energy_benchmark [--benchmark_repetitions=5]
 //
@@ -8,6 +9,7 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -21,6 +23,7 @@ namespace finecap {
 namespace {
 
 struct SkirtFrame {
+  std::string dir;  // The capture, removed at exit.
   std::unique_ptr<SequenceModel> model;
   ReferenceColors colors;
   FrameInput input;
@@ -46,11 +49,13 @@ const SkirtFrame& Skirt() {
     GenerateSyntheticCapture(config.synth, dir);
     Capture capture = Capture::Open(dir);
     auto* skirt = new SkirtFrame;
+    skirt->dir = dir;
     skirt->model = std::make_unique<SequenceModel>(capture.ReadCoarseMesh(0), capture.vertex_mask(),
                                                    config.refine, dir);
     skirt->colors = ComputeSequenceColors(*skirt->model, ReadFrame(&capture, 0), config.refine);
     skirt->input = ReadFrame(&capture, 3);
-    std::filesystem::remove_all(dir);
+    static const std::string removed_at_exit = dir;
+    std::atexit([] { std::filesystem::remove_all(removed_at_exit); });
     return skirt;
   }();
   return *frame;
@@ -93,6 +98,18 @@ void BM_PrepareFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PrepareFrame)->Unit(benchmark::kMillisecond);
+
+// What the frame loop's reader does for every frame: the part of a frame's time that is not
+// compute on the model.
+void BM_ReadFrame(benchmark::State& state) {
+  Capture capture = Capture::Open(Skirt().dir);
+  for (auto _ : state) {
+    FrameInput input = ReadFrame(&capture, 3);
+    benchmark::DoNotOptimize(input.images.data());
+  }
+  state.counters["cameras"] = capture.num_cameras();
+}
+BENCHMARK(BM_ReadFrame)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace finecap

@@ -2,13 +2,17 @@
 # Renders an HTML report (finecap eval's report.html) in headless Chromium to a PNG and checks
 # what a reader would see: every <img> of the report loads and decodes in the browser, every
 # picture it refers to by file name exists and is a PNG or JPEG, and the screenshot exists and
-# is not of a single colour.
+# is not of a single colour. When the report has a 3D view (finecap eval's, with three.js), its
+# canvas must show up within the screenshot and each half (input | refined) must have drawn a
+# shaded mesh: at least 2 % of its pixels off the background and at least 16 grey levels among
+# them (a blank or flat-shaded canvas has one or a few).
 #
 # Usage: scripts/check-report.sh REPORT.html OUT.png [WIDTH HEIGHT]
 #   WIDTH x HEIGHT: the browser window, CSS pixels (default 1280 x 2000); the screenshot shows
 #   the top of the page down to HEIGHT.
 # Installs Debian's chromium when it is missing (apt-get; sudo when not root).
-# Exit code 0 when every check passes; 1 with one message per problem otherwise.
+# Exit code 0 when every check passes; 1 with one message per problem otherwise; 77 when chromium
+# cannot be installed or started (nothing was checked: tests report that as skipped).
 set -euo pipefail
 
 fail() {
@@ -28,15 +32,23 @@ report_dir="$(cd "$(dirname "$report")" && pwd)"
 report_abs="$report_dir/$(basename "$report")"
 out_abs="$(cd "$(dirname "$out")" && pwd)/$(basename "$out")"
 
+unavailable() {
+  echo "check-report: $*; nothing checked" >&2
+  exit 77
+}
+
 install_chromium() {
-  command -v chromium >/dev/null && return
-  local sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  echo "check-report: installing chromium"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
-    chromium fonts-dejavu-core >/dev/null
-  command -v chromium >/dev/null || fail "chromium could not be installed"
+  if ! command -v chromium >/dev/null; then
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    echo "check-report: installing chromium"
+    { $sudo apt-get update -qq &&
+      DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends \
+        chromium fonts-dejavu-core >/dev/null; } || true
+    command -v chromium >/dev/null || unavailable "chromium could not be installed"
+  fi
+  browser --dump-dom "data:text/html,<p>up</p>" | grep -q "<p>up</p>" ||
+    unavailable "chromium does not start here (headless)"
 }
 
 # The first bytes of a PNG or a JPEG file.
@@ -64,9 +76,11 @@ check_referenced_files() {
   return $problems
 }
 
+# WebGL without a GPU: Chromium falls back to SwiftShader (software) with --disable-gpu; newer
+# releases ask for --enable-unsafe-swiftshader to allow that fallback.
 browser() {
-  timeout 180 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars \
-    --allow-file-access-from-files --virtual-time-budget=10000 "$@" 2>/dev/null
+  timeout 180 chromium --headless --no-sandbox --disable-gpu --enable-unsafe-swiftshader \
+    --hide-scrollbars --allow-file-access-from-files --virtual-time-budget=10000 "$@" 2>/dev/null
 }
 
 # Runs `script` in a copy of `page` (resolving relative links against the report's folder) and
@@ -75,8 +89,15 @@ run_in_page() {
   local page="$1" script="$2" copy
   copy="$(mktemp --suffix=.html)"
   {
-    echo "<base href=\"file://$report_dir/\">"
-    cat "$page"
+    # After the doctype, so the copy is laid out as the page itself (not in quirks mode).
+    if head -n 1 "$page" | grep -qi '^<!DOCTYPE'; then
+      head -n 1 "$page"
+      echo "<base href=\"file://$report_dir/\">"
+      tail -n +2 "$page"
+    else
+      echo "<base href=\"file://$report_dir/\">"
+      cat "$page"
+    fi
     echo "<div id=\"finecap-check\"></div><script>$script</script>"
   } >"$copy"
   browser --dump-dom "file://$copy" | grep -o 'id="finecap-check">[^<]*' | sed 's/.*>//'
@@ -93,15 +114,22 @@ window.addEventListener("load", () => {
       : "broken: " + broken.map(i => i.alt || i.src.slice(0, 60)).join("; ");
 });'
 
-# The number of distinct colours of the screenshot (sampled on a grid), read through a canvas.
-COLOURS_SCRIPT='
-window.addEventListener("load", () => {
+# The screenshot (the <img id="shot"> of the page) drawn into a 2D canvas, whose context it returns.
+SHOT_CONTEXT='
+function shotContext() {
   const image = document.getElementById("shot");
   const canvas = document.createElement("canvas");
   canvas.width = image.naturalWidth;
   canvas.height = image.naturalHeight;
   const context = canvas.getContext("2d");
   context.drawImage(image, 0, 0);
+  return context;
+}'
+
+# The number of distinct colours of the screenshot (sampled on a grid), read through a canvas.
+COLOURS_SCRIPT="$SHOT_CONTEXT"'
+window.addEventListener("load", () => {
+  const context = shotContext(), canvas = context.canvas;
   const pixels = context.getImageData(0, 0, canvas.width, canvas.height).data;
   const colours = new Set();
   const step = 4 * 7;
@@ -111,6 +139,74 @@ window.addEventListener("load", () => {
   document.getElementById("finecap-check").textContent =
       canvas.width + "x" + canvas.height + " " + colours.size;
 });'
+
+# The 3D view's canvas in page pixels, "X Y WIDTH HEIGHT"; "none" when the page has none.
+VIEWER_RECT_SCRIPT='
+window.addEventListener("load", () => {
+  const canvas = document.querySelector("#finecap-viewer canvas");
+  const box = canvas ? canvas.getBoundingClientRect() : null;
+  document.getElementById("finecap-check").textContent = box
+      ? [box.left + scrollX, box.top + scrollY, box.width, box.height].map(Math.round).join(" ")
+      : "none";
+});'
+
+# For each half of the canvas region of the screenshot (input | refined): the percentage of
+# pixels off the background (the top-left pixel of the half) and the number of grey levels among
+# them, "PERCENT LEVELS PERCENT LEVELS". The region is inset by 4 pixels to skip the border, by
+# 24 at the top to skip the labels.
+VIEWER_PIXELS_SCRIPT="$SHOT_CONTEXT"'
+window.addEventListener("load", () => {
+  const [x, y, width, height] = "RECT".split(" ").map(Number);
+  const context = shotContext();
+  const halves = [0, 1].map(half => {
+    const left = x + 4 + half * Math.floor(width / 2), top = y + 24;
+    const w = Math.floor(width / 2) - 8, h = height - 28;
+    const pixels = context.getImageData(left, top, w, h).data;
+    const background = [pixels[0], pixels[1], pixels[2]];
+    const levels = new Set();
+    let off = 0;
+    for (let i = 0; i < pixels.length; i += 4) {
+      const difference = Math.max(...[0, 1, 2].map(c => Math.abs(pixels[i + c] - background[c])));
+      if (difference <= 12) continue;
+      ++off;
+      levels.add(Math.round(0.299 * pixels[i] + 0.587 * pixels[i + 1] + 0.114 * pixels[i + 2]));
+    }
+    return (100 * off / (w * h)).toFixed(1) + " " + levels.size;
+  });
+  document.getElementById("finecap-check").textContent = halves.join(" ");
+});'
+
+# Checks the 3D view's canvas region of the screenshot `$1`; `$2` is its rectangle.
+check_viewer() {
+  local shot="$1" rect="$2" page result
+  read -r _ rect_y _ rect_height <<<"$rect"
+  if [ $((rect_y + rect_height)) -gt "$height" ]; then
+    echo "check-report: $report: the 3D view ($rect) is below the screenshot's $height pixels" >&2
+    return 1
+  fi
+  page="$(mktemp --suffix=.html)"
+  printf '<img id="shot" src="data:image/png;base64,%s">' "$(base64 -w0 "$shot")" >"$page"
+  result="$(run_in_page "$page" "${VIEWER_PIXELS_SCRIPT/RECT/$rect}")"
+  rm -f "$page"
+  local input_share input_levels refined_share refined_levels
+  read -r input_share input_levels refined_share refined_levels <<<"$result"
+  if [ -z "${refined_levels:-}" ]; then
+    echo "check-report: $shot: the 3D view's region could not be read back" >&2
+    return 1
+  fi
+  echo "check-report: 3D view: input ${input_share} % of pixels drawn, $input_levels grey" \
+    "levels; refined ${refined_share} %, $refined_levels levels"
+  local problems=0 name share levels
+  for name in input refined; do
+    share="${name}_share"
+    levels="${name}_levels"
+    if [ "${!share%.*}" -lt 2 ] || [ "${!levels}" -lt 16 ]; then
+      echo "check-report: $shot: the 3D view's $name half shows no shaded mesh" >&2
+      problems=1
+    fi
+  done
+  return $problems
+}
 
 install_chromium
 problems=0
@@ -141,5 +237,12 @@ elif [ "$colours" -le 1 ]; then
 else
   echo "check-report: $out: $size pixels, $colours colours"
 fi
+viewer_rect="$(run_in_page "$report_abs" "$VIEWER_RECT_SCRIPT")"
+case "$viewer_rect" in
+  none) echo "check-report: $report: no 3D view" ;;
+  "") echo "check-report: $report: the browser reported no layout for the 3D view" >&2
+    problems=1 ;;
+  *) check_viewer "$out_abs" "$viewer_rect" || problems=1 ;;
+esac
 [ "$problems" -eq 0 ] || exit 1
 echo "check-report: ok"

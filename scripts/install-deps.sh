@@ -9,8 +9,9 @@ PACKAGES=(
   libopencv-dev libopencv-contrib-dev libassimp-dev
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox clang-format
+  gnuplot-nox clang-format libjs-three
   clang-14 libclang-rt-14-dev
+  colmap  # a test reads the text model COLMAP writes itself; 4 MB download, 16 MB installed
 )
 
 missing=()

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include <Eigen/LU>
+#include <Eigen/SVD>
 
 #include "finecap/error.h"
 
@@ -27,28 +28,56 @@ Eigen::Vector2d Camera::Project(const Eigen::Vector3d& world,
   const double inv_z = 1.0 / p.z();
   const double x = p.x() * inv_z;
   const double y = p.y() * inv_z;
-  const auto [k1, k2, p1, p2, k3] = distortion;
+  const auto [k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4] = distortion;
 
+  // OpenCV's model: a rational radial factor, tangential terms and thin prism terms.
   const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  const double numerator = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double denominator = 1.0 + r2 * (k4 + r2 * (k5 + r2 * k6));
+  const double radial = numerator / denominator;
+  const double prism_x = r2 * (s1 + r2 * s2);
+  const double prism_y = r2 * (s3 + r2 * s4);
+  const double xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) + prism_x;
+  const double yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y + prism_y;
   const Eigen::Vector2d pixel(K(0, 0) * xd + K(0, 1) * yd + K(0, 2), K(1, 1) * yd + K(1, 2));
   if (jacobian == nullptr) return pixel;
 
   // Chain rule: pixel <- distorted <- normalised <- camera point <- world point.
-  const double dradial_dr2 = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);
+  const double dnumerator_dr2 = k1 + r2 * (2.0 * k2 + 3.0 * r2 * k3);
+  const double ddenominator_dr2 = k4 + r2 * (2.0 * k5 + 3.0 * r2 * k6);
+  const double dradial_dr2 = (dnumerator_dr2 - radial * ddenominator_dr2) / denominator;
+  const double dprism_x_dr2 = s1 + 2.0 * r2 * s2;
+  const double dprism_y_dr2 = s3 + 2.0 * r2 * s4;
   Eigen::Matrix2d d_distorted_d_normalised;
-  d_distorted_d_normalised(0, 0) = radial + 2.0 * x * x * dradial_dr2 + 2.0 * p1 * y + 6.0 * p2 * x;
-  d_distorted_d_normalised(0, 1) = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
-  d_distorted_d_normalised(1, 0) = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
-  d_distorted_d_normalised(1, 1) = radial + 2.0 * y * y * dradial_dr2 + 6.0 * p1 * y + 2.0 * p2 * x;
+  d_distorted_d_normalised(0, 0) =
+      radial + 2.0 * x * (x * dradial_dr2 + dprism_x_dr2) + 2.0 * p1 * y + 6.0 * p2 * x;
+  d_distorted_d_normalised(0, 1) =
+      2.0 * y * (x * dradial_dr2 + dprism_x_dr2) + 2.0 * p1 * x + 2.0 * p2 * y;
+  d_distorted_d_normalised(1, 0) =
+      2.0 * x * (y * dradial_dr2 + dprism_y_dr2) + 2.0 * p1 * x + 2.0 * p2 * y;
+  d_distorted_d_normalised(1, 1) =
+      radial + 2.0 * y * (y * dradial_dr2 + dprism_y_dr2) + 6.0 * p1 * y + 2.0 * p2 * x;
   Eigen::Matrix<double, 2, 3> d_normalised_d_camera;
   d_normalised_d_camera << inv_z, 0.0, -x * inv_z, 0.0, inv_z, -y * inv_z;
   Eigen::Matrix2d d_pixel_d_distorted;
   d_pixel_d_distorted << K(0, 0), K(0, 1), 0.0, K(1, 1);
   *jacobian = d_pixel_d_distorted * d_distorted_d_normalised * d_normalised_d_camera * R;
   return pixel;
+}
+
+Eigen::Matrix3d NearestRotation(const Eigen::Matrix3d& matrix, const std::string& where,
+                                double* deviation) {
+  Require(matrix.allFinite(), where, "non-finite value in R");
+  const double distance = (matrix.transpose() * matrix - Eigen::Matrix3d::Identity()).norm();
+  Require(distance < kRotationTolerance && matrix.determinant() > 0.0, where,
+          "R is not a rotation matrix (singular, scaled, sheared or reflecting): ||R^T R - I|| = " +
+              std::to_string(distance) + ", det R = " + std::to_string(matrix.determinant()) +
+              "; a rounded rotation is accepted up to ||R^T R - I|| < " +
+              std::to_string(kRotationTolerance));
+  if (deviation != nullptr) *deviation = distance;
+  // The orthogonal polar factor U V^T of R = U S V^T; det > 0 and S close to I make it proper.
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrix, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return svd.matrixU() * svd.matrixV().transpose();
 }
 
 namespace {

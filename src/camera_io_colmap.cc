@@ -18,7 +18,7 @@ struct ColmapIntrinsics {
   int width = 0;
   int height = 0;
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
-  std::array<double, 5> distortion = {0, 0, 0, 0, 0};
+  std::array<double, 12> distortion = {};
 };
 
 // One posed image of images.txt.

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
-#include <Eigen/Geometry>
 
 #include "finecap/camera_io.h"
 #include "finecap/error.h"
@@ -130,9 +129,12 @@ void ReadIntrinsics(const YAML::Node& intri, const std::string& path, Camera* ca
   camera->K = RowMajor3x3(RequireMatrix(intri, "K_" + name, 3, 3, path));
   const OpenCvMatrix dist = ReadMatrix(intri, "dist_" + name, path);
   if (!dist.empty()) {
-    Require((dist.rows == 1 || dist.cols == 1) && dist.data.size() <= 5,
-            KeyLocation(path, "dist_" + name), "must be a vector of at most 5 coefficients");
-    std::copy(dist.data.begin(), dist.data.end(), camera->distortion.begin());
+    const std::string where = KeyLocation(path, "dist_" + name);
+    Require(dist.rows == 1 || dist.cols == 1, where, "must be a vector (1xN or Nx1)");
+    // EasyMocap writes 1x5; fewer than 4 (k1 alone, say) means the rest are zero.
+    std::vector<double> coefficients = dist.data;
+    if (coefficients.size() < 4) coefficients.resize(4, 0.0);
+    camera->distortion = internal::OpenCvDistortion(coefficients, where);
   }
   const YAML::Node height = intri["H_" + name];
   const YAML::Node width = intri["W_" + name];
@@ -144,14 +146,6 @@ void ReadIntrinsics(const YAML::Node& intri, const std::string& path, Camera* ca
   }
 }
 
-// R_<cam> is a Rodrigues vector: its direction the axis, its length the angle.
-Eigen::Matrix3d RotationOfRodrigues(const std::vector<double>& r) {
-  const Eigen::Vector3d vector(r[0], r[1], r[2]);
-  const double angle = vector.norm();
-  if (angle < 1e-300) return Eigen::Matrix3d::Identity();
-  return Eigen::AngleAxisd(angle, vector / angle).toRotationMatrix();
-}
-
 void ReadExtrinsics(const YAML::Node& extri, const std::string& path, Camera* camera) {
   const std::string& name = camera->name;
   if (!ReadMatrix(extri, "Rot_" + name, path).empty()) {
@@ -159,7 +153,8 @@ void ReadExtrinsics(const YAML::Node& extri, const std::string& path, Camera* ca
   } else {
     Require(!ReadMatrix(extri, "R_" + name, path).empty(), KeyLocation(path, "R_" + name),
             "missing key (neither R_" + name + " nor Rot_" + name + " is given)");
-    camera->R = RotationOfRodrigues(RequireMatrix(extri, "R_" + name, 3, 1, path));
+    const std::vector<double> r = RequireMatrix(extri, "R_" + name, 3, 1, path);
+    camera->R = internal::RotationOfRodrigues(Eigen::Vector3d(r[0], r[1], r[2]));
   }
   const std::vector<double> t = RequireMatrix(extri, "T_" + name, 3, 1, path);
   camera->t = Eigen::Vector3d(t[0], t[1], t[2]);
@@ -177,13 +172,16 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
       camera.name = name;
       ReadIntrinsics(intri, intri_path, &camera);
       ReadExtrinsics(extri, extri_path, &camera);
-      internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
       cameras.push_back(camera);
     }
   } catch (const YAML::Exception& error) {
     // A yaml-cpp failure that the checks above did not foresee still ends in one Error.
     throw Error(intri_path + " / " + extri_path,
                 std::string("malformed OpenCV YAML file: ") + error.what());
+  }
+  internal::MakeRotationsExact(&cameras, extri_path);
+  for (const Camera& camera : cameras) {
+    internal::ValidateCameraExceptUnknownSize(camera, intri_path + " / " + extri_path);
   }
   internal::RequireUniqueCameraNames(cameras, intri_path);
   return cameras;

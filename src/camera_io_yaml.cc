@@ -1,5 +1,5 @@
 // finecap's cameras.yaml: reader and writer.
-#include <set>
+#include <algorithm>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -18,7 +18,8 @@ constexpr char kSchemaComment[] =
     "# Convention: world units are metres; a world point X maps to camera coordinates\n"
     "# x_cam = R * X + t; OpenCV axes (x right, y down, z forward); pixel = K * distort(x_cam / "
     "z)\n"
-    "# with the centre of the top-left pixel at (0, 0); OpenCV distortion (k1, k2, p1, p2, k3).\n"
+    "# with the centre of the top-left pixel at (0, 0); OpenCV distortion (k1, k2, p1, p2, k3,\n"
+    "# then k4, k5, k6 of the rational model and s1, s2, s3, s4 of the thin prism model).\n"
     "# Schema:\n"
     "# cameras:\n"
     "#   - name: cam0\n"
@@ -27,9 +28,11 @@ constexpr char kSchemaComment[] =
     "#     K: [fx, s, cx, 0, fy, cy, 0, 0, 1]  # row-major 3x3, pixels\n"
     "#     R: [r00, r01, ..., r22]             # row-major world-to-camera rotation\n"
     "#     t: [tx, ty, tz]                     # metres\n"
-    "#     distortion: [k1, k2, p1, p2, k3]    # optional, OpenCV order, default zeros\n";
+    "#     distortion: [k1, k2, p1, p2, k3]    # optional, OpenCV order: 4, 5, 8 or 12 numbers\n";
 
-const std::set<std::string> kCameraKeys = {"name", "width", "height", "K", "R", "t", "distortion"};
+// In the order of the schema, which is the order an error lists them in.
+const std::vector<std::string> kCameraKeys = {"name", "width", "height",    "K",
+                                              "R",    "t",     "distortion"};
 
 // The text of a mapping's key; a list or mapping used as a key (YAML allows it) is refused.
 std::string KeyText(const YAML::Node& key, const std::string& where) {
@@ -56,14 +59,19 @@ T ReadScalar(const YAML::Node& node, const std::string& where, const std::string
   }
 }
 
-std::vector<double> ReadNumberList(const YAML::Node& node, size_t length,
-                                   const std::string& where) {
-  Require(node.IsSequence() && node.size() == length, where,
-          "must be a list of " + std::to_string(length) + " numbers");
+std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& where) {
+  Require(node.IsSequence(), where, "must be a list of numbers");
   std::vector<double> values;
   for (const YAML::Node& element : node)
     values.push_back(ReadScalar<double>(element, where, "a number"));
   return values;
+}
+
+std::vector<double> ReadNumberList(const YAML::Node& node, size_t length,
+                                   const std::string& where) {
+  Require(node.IsSequence() && node.size() == length, where,
+          "must be a list of " + std::to_string(length) + " numbers");
+  return ReadNumbers(node, where);
 }
 
 Eigen::Matrix3d ReadRowMajor3x3(const YAML::Node& node, const std::string& where) {
@@ -82,7 +90,9 @@ Camera ReadCamera(const YAML::Node& node, int index, const std::string& path) {
   Require(!camera.name.empty(), entry, "empty camera name");
   for (const auto& item : node) {
     const std::string key = KeyText(item.first, entry);
-    Require(kCameraKeys.count(key) > 0, Location(path, camera.name, key), "unknown key");
+    Require(std::find(kCameraKeys.begin(), kCameraKeys.end(), key) != kCameraKeys.end(),
+            Location(path, camera.name, key),
+            "unknown key; allowed: " + internal::JoinWithCommas(kCameraKeys));
   }
   for (const char* key : {"width", "height", "K", "R", "t"}) {
     Require(static_cast<bool>(node[key]), Location(path, camera.name, key), "missing key");
@@ -95,11 +105,9 @@ Camera ReadCamera(const YAML::Node& node, int index, const std::string& path) {
   const std::vector<double> t = ReadNumberList(node["t"], 3, Location(path, camera.name, "t"));
   camera.t = Eigen::Vector3d(t[0], t[1], t[2]);
   if (node["distortion"]) {
-    const std::vector<double> distortion =
-        ReadNumberList(node["distortion"], 5, Location(path, camera.name, "distortion"));
-    std::copy(distortion.begin(), distortion.end(), camera.distortion.begin());
+    const std::string where = Location(path, camera.name, "distortion");
+    camera.distortion = internal::OpenCvDistortion(ReadNumbers(node["distortion"], where), where);
   }
-  camera.Validate(path);
   return camera;
 }
 
@@ -133,6 +141,8 @@ std::vector<Camera> CamerasFromYaml(const YAML::Node& root, const std::string& p
   for (size_t i = 0; i < list.size(); ++i) {
     cameras.push_back(ReadCamera(list[i], static_cast<int>(i), path));
   }
+  internal::MakeRotationsExact(&cameras, path);
+  for (const Camera& camera : cameras) camera.Validate(path);
   internal::RequireUniqueCameraNames(cameras, path);
   return cameras;
 }
@@ -169,7 +179,7 @@ void WriteCamerasYaml(const std::vector<Camera>& cameras, const std::string& pat
     out << YAML::Key << "t" << YAML::Value << YAML::Flow
         << std::vector<double>{camera.t.x(), camera.t.y(), camera.t.z()};
     out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
-        << std::vector<double>(camera.distortion.begin(), camera.distortion.end());
+        << internal::ShortestOpenCvDistortion(camera.distortion);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq << YAML::EndMap;

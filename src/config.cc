@@ -17,6 +17,61 @@ std::string AutoText(double factor) {
   return text.str();
 }
 
+std::string NameListText(const std::vector<std::string>& names) {
+  std::string text = "[";
+  for (size_t i = 0; i < names.size(); ++i) text += (i ? ", " : "") + names[i];
+  return text + "]";
+}
+
+void AddValidationKeys(ValidationConfig* validation, ConfigSchema* schema) {
+  schema->AddCustom(
+      "validation.cameras", "list of string", "camera names",
+      "Cameras held out of the refinement: refine scores the input and refined surface in them "
+      "(held-out NCC and MAD in the stats), eval reports them; [] = none.",
+      [validation](const YAML::Node& value, const std::string& where) {
+        std::vector<std::string> names;
+        if (value.IsScalar()) {
+          names.push_back(value.Scalar());  // One name without brackets.
+        } else {
+          Require(value.IsSequence(), where, "expected a list of camera names");
+          for (const YAML::Node& item : value) {
+            Require(item.IsScalar(), where, "expected camera names, found a list or mapping");
+            names.push_back(item.Scalar());
+          }
+        }
+        for (const std::string& name : names) {
+          Require(!name.empty(), where, "a camera name is empty");
+        }
+        validation->cameras = names;
+      },
+      [validation] { return NameListText(validation->cameras); });
+  HeldOutOptions& score = validation->score;
+  schema->AddInt("validation.neighbours", &score.neighbours,
+                 "Training views warped into each held-out view, the nearest by camera centre.", 1,
+                 1000);
+  schema->AddCustom(
+      "validation.window", "int", "odd, [3, 31]",
+      "Side of the windows of the held-out NCC, pixels.",
+      [&score](const YAML::Node& value, const std::string& where) {
+        Require(value.IsScalar(), where, "expected an odd integer");
+        int window = 0;
+        Require(YAML::convert<int>::decode(value, window), where,
+                "expected an odd integer, got '" + value.Scalar() + "'");
+        Require(window >= 3 && window <= 31 && window % 2 == 1, where,
+                "value " + value.Scalar() + " is not an odd integer in [3, 31]");
+        score.window = window;
+      },
+      [&score] { return std::to_string(score.window); });
+  schema->AddDouble("validation.min_std", &score.min_std,
+                    "Held-out NCC windows whose grey levels vary less than this (standard "
+                    "deviation, 0-255) are not scored.",
+                    0.0, 255.0);
+  schema->AddDouble("validation.depth_tolerance_px", &score.depth_tolerance_px,
+                    "A point counts as seen by a training view within this many pixel footprints "
+                    "behind its depth map there.",
+                    0.01, 1000.0);
+}
+
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.dir", &config->capture.dir,
                     "Capture folder (cameras, images or videos, meshes; see the README).");
@@ -53,6 +108,7 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
                     "finecap eval: cameras the flow is measured in, pixels pooled: all, or "
                     "eval_camera (eval.camera only, as the paper's Figure 6).",
                     {"all", "eval_camera"});
+  AddValidationKeys(&config->validation, schema);
 }
 
 void AddModelKeys(Config* config, ConfigSchema* schema) {
@@ -212,7 +268,8 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                  "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0,
                  1000);
   schema->AddBool("refine.keep_input_if_worse", &refine->keep_input_if_worse,
-                  "Write the input surface for a frame whose energy got worse (always flagged).");
+                  "Write the input surface for a frame whose energy, or held-out NCC, got worse "
+                  "(always flagged).");
   schema->AddBool("refine.warm_start", &refine->warm_start,
                   "Start each frame from the previous frame's displacement.");
   schema->AddInt("refine.coarse_to_fine.levels", &refine->coarse_to_fine.levels,
@@ -230,6 +287,7 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
 void Config::Check() const {
   frame_range();
   refine.Check();
+  validation.score.Check();
   synth.Check();
   compare.Check();
 }

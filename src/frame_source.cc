@@ -107,8 +107,18 @@ class Undistorter {
       for (int c = 0; c < 3; ++c) K.at<double>(r, c) = camera.K(r, c);
     }
     const std::vector<double> distortion(camera.distortion.begin(), camera.distortion.end());
-    cv::initUndistortRectifyMap(K, distortion, cv::Mat(), K, cv::Size(camera.width, camera.height),
-                                CV_16SC2, map1_, map2_);
+    const cv::Size size(camera.width, camera.height);
+    if (camera.K(0, 1) == 0.0) {
+      cv::initUndistortRectifyMap(K, distortion, cv::Mat(), K, size, CV_16SC2, map1_, map2_);
+      return;
+    }
+    // OpenCV's maps leave out the skew of the distorted image (they take u = fx xd + cx): adding
+    // skew * yd, with yd = (v - cy) / fy read off the map itself, puts it back exactly.
+    cv::Mat map_x, map_y;
+    cv::initUndistortRectifyMap(K, distortion, cv::Mat(), K, size, CV_32FC1, map_x, map_y);
+    const double skew_per_row = camera.K(0, 1) / camera.K(1, 1);
+    map_x += skew_per_row * (map_y - camera.K(1, 2));
+    cv::convertMaps(map_x, map_y, map1_, map2_, CV_16SC2);
   }
 
   cv::Mat Apply(const cv::Mat& image) const {

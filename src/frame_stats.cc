@@ -66,6 +66,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"seconds_solve\": " << JsonNumber(s.seconds_solve)
        << ", \"seconds_evaluation\": " << JsonNumber(s.seconds_evaluation)
        << ", \"seconds_linear_solver\": " << JsonNumber(s.seconds_linear_solver)
+       << ", \"seconds_heldout\": " << JsonNumber(s.seconds_heldout)
        << ", \"surface_gaussians\": " << s.surface_gaussians
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
@@ -74,6 +75,10 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
        << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
+       << ", \"heldout_ncc_input\": " << JsonNumber(s.heldout_ncc_input)
+       << ", \"heldout_ncc_refined\": " << JsonNumber(s.heldout_ncc_refined)
+       << ", \"heldout_mad_input\": " << JsonNumber(s.heldout_mad_input)
+       << ", \"heldout_mad_refined\": " << JsonNumber(s.heldout_mad_refined)
        << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << ", \"skipped_cameras\": [";
   for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
     json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
@@ -103,10 +108,15 @@ struct StatsFields {
       {"seconds_solve", &FrameStats::seconds_solve},
       {"seconds_evaluation", &FrameStats::seconds_evaluation},
       {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
+      {"seconds_heldout", &FrameStats::seconds_heldout},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
       {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm},
+      {"heldout_ncc_input", &FrameStats::heldout_ncc_input},
+      {"heldout_ncc_refined", &FrameStats::heldout_ncc_refined},
+      {"heldout_mad_input", &FrameStats::heldout_mad_input},
+      {"heldout_mad_refined", &FrameStats::heldout_mad_refined},
       {"peak_rss_mb", &FrameStats::peak_rss_mb}};
   std::vector<std::pair<const char*, int FrameStats::*>> ints = {
       {"iterations", &FrameStats::iterations},

@@ -158,6 +158,8 @@ void HtmlReport::AddImage(const cv::Mat& image, const std::string& caption) {
   AddEmbeddedImage("image/png", std::string(png.begin(), png.end()), caption);
 }
 
+void HtmlReport::AddRawHtml(const std::string& html) { body_ += html; }
+
 void HtmlReport::AddEmbeddedImage(const std::string& mime_type, const std::string& bytes,
                                   const std::string& caption) {
   body_ += "<figure><img alt=\"" + EscapeHtml(caption) + "\" src=\"data:" + mime_type + ";base64," +

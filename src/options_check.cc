@@ -1,9 +1,11 @@
-// The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h):
+// The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h)
+// and of the held-out score (heldout_score.h):
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
 #include "finecap/energy_options.h"
 #include "finecap/error.h"
 #include "finecap/gaussian_overlap.h"
+#include "finecap/heldout_score.h"
 #include "finecap/refine.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
@@ -76,6 +78,13 @@ void SweepOptions::Check() const {
 void CoarseToFineOptions::Check() const {
   Require(levels >= 1 && levels <= 5, "refine.coarse_to_fine.levels", "must lie in [1, 5]");
   Require(scale > 1.0 && scale <= 4.0, "refine.coarse_to_fine.scale", "must lie in (1, 4]");
+}
+
+void HeldOutOptions::Check() const {
+  Require(neighbours >= 1, "validation.neighbours", "must be at least 1");
+  Require(window >= 3 && window % 2 == 1, "validation.window", "must be an odd number >= 3");
+  Require(min_std >= 0.0, "validation.min_std", "must be non-negative");
+  Require(depth_tolerance_px > 0.0, "validation.depth_tolerance_px", "must be positive");
 }
 
 }  // namespace finecap

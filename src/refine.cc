@@ -242,6 +242,13 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
 
 }  // namespace
 
+void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
+  result->refined = fine_input;
+  result->normals = ComputeVertexNormals(fine_input);
+  result->k = result->k.array().isFinite().select(0.0 * result->k, result->k);
+  result->kept_input = true;
+}
+
 Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
                               const Eigen::VectorXd* warm_start) {
   if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;

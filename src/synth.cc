@@ -1,6 +1,7 @@
 // The synthetic capture: subject, folds, rig and images put together, and written to disk.
 #include "finecap/synth.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -58,7 +59,7 @@ Camera LookAt(const std::string& name, const RigOptions& rig, const Eigen::Vecto
   camera.R.row(1) = z.cross(x);
   camera.R.row(2) = z;
   camera.t = -camera.R * center;
-  camera.distortion = rig.distortion;
+  std::copy(rig.distortion.begin(), rig.distortion.end(), camera.distortion.begin());
   return camera;
 }
 

@@ -1,7 +1,9 @@
 #include "finecap/camera_io.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -80,6 +82,71 @@ TEST(CamerasYamlTest, DistortionIsOptional) {
   EXPECT_EQ(cameras[0].t.z(), 2.5);
 }
 
+std::string CameraEntry(const std::string& name, const std::string& r, const std::string& extra) {
+  return "  - name: " + name + "\n    width: 640\n    height: 480\n" +
+         "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n    R: " + r + "\n    t: [0, 0, 2]\n" + extra;
+}
+
+const std::string kIdentity = "[1, 0, 0, 0, 1, 0, 0, 0, 1]";
+
+TEST(CamerasYamlTest, RationalAndThinPrismDistortionRoundTrip) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  Camera rational = MakeCamera("rational", 0.3);
+  rational.distortion = {-0.2, 0.07, 0.001, -0.002, 0.01, 0.03, -0.01, 0.004};
+  Camera prism = MakeCamera("prism", -0.4);
+  prism.distortion[10] = 0.0003;
+  WriteCamerasYaml({rational, prism, MakeCamera("plain", 1.0)}, path);
+  const std::string text = testing_util::FileBytes(path);
+  // As OpenCV counts them: 8 for the rational model, 12 with thin prism, else 5.
+  EXPECT_NE(text.find("distortion: [-0.20000000000000001, 0.070000000000000007, 0.001, -0.002, "
+                      "0.01, 0.029999999999999999, -0.01, 0.0040000000000000001]"),
+            std::string::npos)
+      << text;
+  const std::vector<Camera> read = ReadCamerasYaml(path);
+  ASSERT_EQ(read.size(), 3u);
+  ExpectSameCamera(rational, read[0]);
+  ExpectSameCamera(prism, read[1]);
+  ExpectSameCamera(MakeCamera("plain", 1.0), read[2]);
+}
+
+TEST(CamerasYamlTest, FourDistortionCoefficientsAreK1K2P1P2) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  WriteText(path, "cameras:\n" + CameraEntry("cam0", kIdentity,
+                                             "    distortion: [-0.1, 0.02, 0.001, 0.002]\n"));
+  const std::array<double, 12> expected = {-0.1, 0.02, 0.001, 0.002};
+  EXPECT_EQ(ReadCamerasYaml(path).at(0).distortion, expected);
+}
+
+// A rotation written to 6 significant digits, as a published calibration's is (orthonormal to
+// about 1.4e-6): read as the nearest rotation, with one warning for the whole file.
+TEST(CamerasYamlTest, RoundedRotationIsMadeExactWithOneWarning) {
+  const std::string path = MakeTempDir("yaml") + "/cameras.yaml";
+  std::string cameras = "cameras:\n";
+  const Eigen::Matrix3d exact =
+      Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.2, 1.0, -0.4).normalized()).toRotationMatrix();
+  std::string rounded = "[";
+  for (int i = 0; i < 9; ++i) {
+    char number[32];
+    std::snprintf(number, sizeof(number), "%.6g", exact(i / 3, i % 3));
+    rounded += std::string(i ? ", " : "") + number;
+  }
+  rounded += "]";
+  for (const char* name : {"a", "b", "c"}) cameras += CameraEntry(name, rounded, "");
+  WriteText(path, cameras);
+  ::testing::internal::CaptureStderr();
+  const std::vector<Camera> read = ReadCamerasYaml(path);
+  const std::string warnings = ::testing::internal::GetCapturedStderr();
+  ASSERT_EQ(read.size(), 3u);
+  for (const Camera& camera : read) {
+    EXPECT_LT((camera.R.transpose() * camera.R - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+    EXPECT_LT((camera.R - exact).norm(), 5e-6);
+  }
+  EXPECT_EQ(std::count(warnings.begin(), warnings.end(), '\n'), 1) << warnings;
+  EXPECT_NE(warnings.find(path), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("3 cameras"), std::string::npos) << warnings;
+  EXPECT_NE(warnings.find("nearest rotation"), std::string::npos) << warnings;
+}
+
 TEST(CamerasYamlTest, WriterRefusesAnInvalidCameraAndLeavesNoFile) {
   const std::string dir = MakeTempDir("yaml");
   Camera camera = MakeCamera("cam0", 0.3);
@@ -95,13 +162,6 @@ struct BadYamlCase {
   std::vector<std::string> expected_parts;  // Besides the file name.
 };
 void PrintTo(const BadYamlCase& c, std::ostream* os) { *os << c.label; }
-
-std::string CameraEntry(const std::string& name, const std::string& r, const std::string& extra) {
-  return "  - name: " + name + "\n    width: 640\n    height: 480\n" +
-         "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n    R: " + r + "\n    t: [0, 0, 2]\n" + extra;
-}
-
-const std::string kIdentity = "[1, 0, 0, 0, 1, 0, 0, 0, 1]";
 
 class BadCamerasYamlTest : public ::testing::TestWithParam<BadYamlCase> {};
 
@@ -121,9 +181,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadYamlCase{"UnknownTopLevelKey",
                     "cameras:\n" + CameraEntry("cam0", kIdentity, "") + "units: mm\n",
                     {"unknown top-level key 'units'"}},
-        BadYamlCase{"UnknownKey",
-                    "cameras:\n" + CameraEntry("cam0", kIdentity, "    focal: 500\n"),
-                    {"cam0", "'focal'", "unknown key"}},
+        BadYamlCase{
+            "UnknownKey",
+            "cameras:\n" + CameraEntry("cam0", kIdentity, "    focal: 500\n"),
+            {"cam0", "'focal'", "unknown key; allowed: name, width, height, K, R, t, distortion"}},
         BadYamlCase{"MissingKey",
                     "cameras:\n  - name: cam0\n    width: 640\n    height: 480\n"
                     "    R: [1, 0, 0, 0, 1, 0, 0, 0, 1]\n    t: [0, 0, 2]\n",
@@ -132,6 +193,17 @@ INSTANTIATE_TEST_SUITE_P(
             "WrongType",
             "cameras:\n" + CameraEntry("cam0", kIdentity, "    distortion: [a, 0, 0, 0, 0]\n"),
             {"cam0", "'distortion'", "must be a number"}},
+        BadYamlCase{"ThreeDistortionCoefficients",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity, "    distortion: [0.1, 0, 0]\n"),
+                    {"cam0", "'distortion'", "4, 5, 8, 12 or 14 coefficients", "not 3"}},
+        BadYamlCase{"TiltedSensor",
+                    "cameras:\n" + CameraEntry("cam0", kIdentity,
+                                               "    distortion: [0.1, 0, 0, 0, 0, 0, 0, 0, 0, 0, "
+                                               "0, 0, 0.01, 0]\n"),
+                    {"cam0", "'distortion'", "tauX, tauY"}},
+        BadYamlCase{"ShearedR",
+                    "cameras:\n" + CameraEntry("cam0", "[1, 0.01, 0, 0, 1, 0, 0, 0, 1]", ""),
+                    {"cam0", "not a rotation", "||R^T R - I||"}},
         BadYamlCase{"FractionalWidth",
                     "cameras:\n  - name: cam0\n    width: 640.5\n    height: 480\n"
                     "    K: [500, 0, 320, 0, 500, 240, 0, 0, 1]\n"
@@ -235,6 +307,91 @@ INSTANTIATE_TEST_SUITE_P(
                       ColmapModelCase{"RADIAL", {700, 401, 299, -0.12, 0.03}},
                       ColmapModelCase{"OPENCV", {700, 710, 401, 299, -0.12, 0.03, 0.002, -0.001}}),
     [](const ::testing::TestParamInfo<ColmapModelCase>& info) { return info.param.model; });
+
+// Runs `command` with sh; its output goes to `log`. True when it exits 0.
+bool RunCommand(const std::string& command, const std::string& log) {
+  return std::system((command + " > '" + log + "' 2>&1").c_str()) == 0;
+}
+
+// A model made from known cameras (OPENCV, PINHOLE, SIMPLE_RADIAL and RADIAL intrinsics, one
+// posed image each), converted by COLMAP itself to its binary model and back to text; what COLMAP
+// wrote is read and must give the known cameras.
+TEST(ColmapTextModelTest, ReadsWhatColmapItselfWrote) {
+  if (std::system("command -v colmap > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "colmap is not installed (Debian: apt-get install colmap, which "
+                    "scripts/install-deps.sh does): the COLMAP-written model is not tested";
+  }
+  const std::string dir = MakeTempDir("colmap_tool");
+  struct Known {
+    std::string model;
+    std::vector<double> params;
+    Camera camera;
+  };
+  std::vector<Known> known = {
+      {"OPENCV", {1234.5, 1236.25, 640.5, 360.25, -0.12, 0.034, 0.0011, -0.0007}, {}},
+      {"PINHOLE", {900.0, 905.5, 512.0, 384.0}, {}},
+      {"SIMPLE_RADIAL", {1500.75, 960.0, 540.0, -0.05}, {}},
+      {"RADIAL", {1111.0, 700.5, 400.5, 0.02, -0.003}, {}}};
+  std::ostringstream cameras_txt, images_txt;
+  cameras_txt.precision(17);
+  images_txt.precision(17);
+  for (size_t i = 0; i < known.size(); ++i) {
+    const int id = static_cast<int>(i) + 1;
+    Camera& camera = known[i].camera;
+    camera.name = "cam" + std::to_string(i);
+    camera.width = 1280 + 10 * id;
+    camera.height = 720 + 10 * id;
+    // finecap's camera by hand from COLMAP's model definitions: pixel centres at +0.5 there.
+    const std::vector<double>& p = known[i].params;
+    const bool one_focal = known[i].model == "SIMPLE_RADIAL" || known[i].model == "RADIAL";
+    const size_t c = one_focal ? 1 : 2;
+    camera.K << p[0], 0.0, p[c] - 0.5, 0.0, one_focal ? p[0] : p[1], p[c + 1] - 0.5, 0.0, 0.0, 1.0;
+    if (known[i].model == "OPENCV") camera.distortion = {p[4], p[5], p[6], p[7]};
+    if (known[i].model == "SIMPLE_RADIAL") camera.distortion = {p[3]};
+    if (known[i].model == "RADIAL") camera.distortion = {p[3], p[4]};
+    const Eigen::Quaterniond q(
+        Eigen::AngleAxisd(0.3 + 0.9 * id, Eigen::Vector3d(0.1 * id, 1.0, -0.2).normalized()));
+    camera.R = q.toRotationMatrix();
+    camera.t = Eigen::Vector3d(0.1 * id, -0.25, 3.0 + 0.5 * id);
+    cameras_txt << id << " " << known[i].model << " " << camera.width << " " << camera.height;
+    for (double value : p) cameras_txt << " " << value;
+    cameras_txt << "\n";
+    images_txt << id << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+               << camera.t.x() << " " << camera.t.y() << " " << camera.t.z() << " " << id << " "
+               << camera.name << "/000000.png\n\n";
+  }
+  WriteText(dir + "/text/cameras.txt", cameras_txt.str());
+  WriteText(dir + "/text/images.txt", images_txt.str());
+  WriteText(dir + "/text/points3D.txt", "");
+  std::filesystem::create_directories(dir + "/binary");
+  std::filesystem::create_directories(dir + "/colmap");
+  const std::string log = dir + "/colmap.log";
+  ASSERT_TRUE(RunCommand("colmap model_converter --input_path " + dir + "/text --output_path " +
+                             dir + "/binary --output_type BIN",
+                         log))
+      << testing_util::FileBytes(log);
+  ASSERT_TRUE(RunCommand("colmap model_converter --input_path " + dir + "/binary --output_path " +
+                             dir + "/colmap --output_type TXT",
+                         log))
+      << testing_util::FileBytes(log);
+  const std::string written = testing_util::FileBytes(dir + "/colmap/cameras.txt");
+  ASSERT_NE(written.find("# Camera list"), std::string::npos) << "not COLMAP's own header";
+
+  const std::vector<Camera> cameras = ReadColmapTextModel(dir + "/colmap");
+  ASSERT_EQ(cameras.size(), known.size());
+  for (size_t i = 0; i < known.size(); ++i) {
+    const Camera& expected = known[i].camera;
+    EXPECT_EQ(cameras[i].name, expected.name);
+    EXPECT_EQ(cameras[i].width, expected.width);
+    EXPECT_EQ(cameras[i].height, expected.height);
+    EXPECT_LT((cameras[i].K - expected.K).norm(), 1e-9) << known[i].model;
+    EXPECT_LT((cameras[i].R - expected.R).norm(), 1e-14) << known[i].model;
+    EXPECT_LT((cameras[i].t - expected.t).norm(), 1e-14) << known[i].model;
+    EXPECT_EQ(cameras[i].distortion, expected.distortion) << known[i].model;
+    const Eigen::Vector3d point(0.2, -0.1, 0.3);
+    EXPECT_LT((cameras[i].Project(point) - expected.Project(point)).norm(), 1e-9);
+  }
+}
 
 TEST(ColmapTextModelTest, NamesCamerasAndTakesTheSmallestImageIdPerCamera) {
   const std::string dir = MakeTempDir("colmap");

@@ -1,5 +1,6 @@
 #include "finecap/camera.h"
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "finecap/error.h"
+#include "test_util.h"
 
 namespace finecap {
 namespace {
@@ -25,8 +27,21 @@ Camera MakeDistortedCamera() {
   return camera;
 }
 
-TEST(CameraTest, ProjectionMatchesOpenCv) {
-  const Camera camera = MakeDistortedCamera();
+// The same camera with OpenCV's rational (k4, k5, k6) and thin prism (s1..s4) terms as well.
+Camera MakeRationalCamera() {
+  Camera camera = MakeDistortedCamera();
+  camera.distortion = {-0.21,  0.08,  0.001, -0.002,  0.01,   0.04,
+                       -0.015, 0.006, 0.002, -0.0007, 0.0015, 0.0004};
+  return camera;
+}
+
+class CameraModelTest : public ::testing::TestWithParam<bool> {
+ protected:
+  Camera MakeCamera() const { return GetParam() ? MakeRationalCamera() : MakeDistortedCamera(); }
+};
+
+TEST_P(CameraModelTest, ProjectionMatchesOpenCv) {
+  const Camera camera = MakeCamera();
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> coordinate(-0.5, 0.5);
   std::vector<cv::Point3d> points;
@@ -50,8 +65,8 @@ TEST(CameraTest, ProjectionMatchesOpenCv) {
   }
 }
 
-TEST(CameraTest, ProjectionJacobianMatchesCentralDifferences) {
-  const Camera camera = MakeDistortedCamera();
+TEST_P(CameraModelTest, ProjectionJacobianMatchesCentralDifferences) {
+  const Camera camera = MakeCamera();
   const Eigen::Vector3d point(0.13, -0.27, 0.31);
   Eigen::Matrix<double, 2, 3> analytic;
   camera.Project(point, &analytic);
@@ -62,6 +77,37 @@ TEST(CameraTest, ProjectionJacobianMatchesCentralDifferences) {
     const Eigen::Vector2d numeric =
         (camera.Project(point + step) - camera.Project(point - step)) / (2.0 * h);
     EXPECT_LT((analytic.col(axis) - numeric).norm(), 1e-6 * numeric.norm() + 1e-6) << axis;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(FiveAndTwelveCoefficients, CameraModelTest, ::testing::Bool());
+
+TEST(CameraTest, NearestRotationRepairsRoundedRotationsAndRefusesTheRest) {
+  const Eigen::Matrix3d exact =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -1.0, 0.4).normalized()).toRotationMatrix();
+  // Rounded to 6 significant digits (a published calibration's 1.4e-6 is of this kind), to
+  // single precision and to 4 decimals: each is accepted and comes back as the nearest rotation.
+  for (const double step : {1e-6, 6e-8, 1e-4}) {
+    Eigen::Matrix3d rounded = exact;
+    for (int i = 0; i < 9; ++i) rounded(i) = std::round(exact(i) / step) * step;
+    double deviation = 0.0;
+    const Eigen::Matrix3d nearest = NearestRotation(rounded, "cameras.yaml", &deviation);
+    EXPECT_GT(deviation, 0.0) << step;
+    EXPECT_LT((nearest.transpose() * nearest - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+    EXPECT_NEAR(nearest.determinant(), 1.0, 1e-14);
+    EXPECT_LT((nearest - exact).norm(), 10.0 * step) << step;
+    Camera camera = MakeDistortedCamera();
+    camera.R = nearest;
+    EXPECT_NO_THROW(camera.Validate("cameras.yaml"));
+  }
+  const Eigen::Matrix3d scaled = 1.001 * exact;
+  Eigen::Matrix3d sheared = exact;
+  sheared(0, 1) += 0.01;
+  const Eigen::Matrix3d reflected = -exact;
+  for (const Eigen::Matrix3d& wrong :
+       {scaled, sheared, reflected, Eigen::Matrix3d::Zero().eval()}) {
+    testing_util::ExpectErrorMentions([&] { NearestRotation(wrong, "cameras.yaml (camera 'c')"); },
+                                      {"cameras.yaml (camera 'c')", "not a rotation"});
   }
 }
 

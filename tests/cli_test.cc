@@ -19,9 +19,9 @@ struct RunResult {
   std::string output;  // stdout and stderr together.
 };
 
-RunResult RunFinecap(const std::string& arguments) {
+RunResult RunFinecap(const std::string& arguments, const std::string& prefix = "") {
   RunResult result;
-  const std::string command = std::string(FINECAP_BINARY) + " " + arguments + " 2>&1";
+  const std::string command = prefix + std::string(FINECAP_BINARY) + " " + arguments + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
   std::array<char, 4096> buffer;
@@ -29,6 +29,12 @@ RunResult RunFinecap(const std::string& arguments) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// The same, run from `working` with `environment` ("NAME=value ...") set.
+RunResult RunFinecapIn(const fs::path& working, const std::string& environment,
+                       const std::string& arguments) {
+  return RunFinecap(arguments, "cd '" + working.string() + "' && " + environment + " ");
 }
 
 fs::path FreshFolder(const std::string& name) {
@@ -149,6 +155,28 @@ TEST(CliTest, InfoWarnsAboutVerticesNoCameraSees) {
   EXPECT_NE(result.output.find("seen by no camera within visibility.max_view_angle_deg 1"),
             std::string::npos)
       << result.output;
+}
+
+// Without --out the probe writes into a new folder under $TMPDIR, and nothing into the folder it
+// is run from.
+TEST(CliTest, ProbeWithoutOutWritesNothingIntoTheCurrentDirectory) {
+  const fs::path capture = TinyCapture("probe");
+  const fs::path working = capture.parent_path() / "working";
+  const fs::path temp = capture.parent_path() / "tmp";
+  fs::create_directories(working);
+  fs::create_directories(temp);
+  const RunResult result =
+      RunFinecapIn(working, "TMPDIR=" + temp.string(),
+                   "probe --capture " + capture.string() + " --set runtime.threads=1");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_TRUE(fs::is_empty(working));
+  const std::string prefix = "plot: " + (temp / "finecap-probe-").string();
+  const size_t plot = result.output.find(prefix);
+  ASSERT_NE(plot, std::string::npos) << result.output;
+  const std::string plot_path =
+      result.output.substr(plot + 6, result.output.find('\n', plot) - plot - 6);
+  EXPECT_TRUE(fs::is_regular_file(plot_path)) << plot_path;
+  EXPECT_TRUE(fs::is_regular_file(fs::path(plot_path).parent_path() / "reference_colors.txt"));
 }
 
 TEST(CliTest, UnknownSubcommandAndBadOverrideAreRefused) {

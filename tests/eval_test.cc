@@ -3,6 +3,7 @@
 #include "finecap/evaluation.h"
 #include "finecap/export.h"
 #include "finecap/mesh_io.h"
+#include "finecap/mesh_viewer.h"
 
 #include <cmath>
 #include <filesystem>
@@ -193,6 +194,13 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(report.find("detail recovered"), std::string::npos);
   EXPECT_NE(report.find("flow refined px"), std::string::npos);
+  // The 3D view where three.js is installed, a note in its place otherwise.
+  if (FindThreeJs()) {
+    EXPECT_NE(report.find("id=\"finecap-viewer\""), std::string::npos);
+    EXPECT_NE(report.find("\"name\": \"000002\""), std::string::npos);  // The last frame.
+  } else {
+    EXPECT_NE(report.find("three.js was not found"), std::string::npos);
+  }
   EXPECT_EQ(testing_util::FilesIn(out + "/meshes"), refined_files);  // Nothing else touched.
 
   // eval.flow: none leaves the flow figures out.

@@ -64,10 +64,79 @@ TEST_P(CeresCostTest, SimilarityBlocksPassTheGradientChecker) {
 
 INSTANTIATE_TEST_SUITE_P(AllForms, CeresCostTest, AllEnergyForms(), EnergyFormName);
 
-TEST(CeresCostTest, RegularizerPairsPassTheGradientChecker) {
+TEST(CeresCostTest, SmoothnessBlocksPassTheGradientChecker) {
   std::string error;
-  EXPECT_TRUE(CheckGradient(RegularizerPairCost(3.5, false), {0.004, -0.002}, &error)) << error;
-  EXPECT_TRUE(CheckGradient(RegularizerPairCost(3.5, true), {0.004}, &error)) << error;
+  // A prior, two free neighbours (parameters 1 and 2) and one fixed at 0.
+  const SmoothnessBlockCost full(0.7, {{1, 3.5}, {-1, 1.5}, {2, 2.0}}, 2);
+  EXPECT_EQ(full.num_residuals(), 4);
+  EXPECT_TRUE(CheckGradient(full, {0.004, -0.002, 0.001}, &error)) << error;
+  // No prior: one residual per neighbour.
+  const SmoothnessBlockCost pairs_only(0.0, {{1, 3.5}}, 1);
+  EXPECT_EQ(pairs_only.num_residuals(), 1);
+  EXPECT_TRUE(CheckGradient(pairs_only, {0.004, -0.002}, &error)) << error;
+  // A prior alone.
+  const SmoothnessBlockCost prior_only(0.7, {}, 0);
+  EXPECT_EQ(prior_only.num_residuals(), 1);
+  EXPECT_TRUE(CheckGradient(prior_only, {0.004}, &error)) << error;
+}
+
+// The problem Ceres is given (similarity blocks, one smoothness block per Gaussian) has the cost
+// LeastSquaresCost computes term by term, with the regulariser and a prior both present: every
+// pair and every prior is in exactly one block.
+TEST(SolverTest, CeresProblemHasTheLeastSquaresCost) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.6}, 3, 23);
+  EnergyOptions energy_options = Options("surface_color", "printed");
+  energy_options.w_prior = 1e-4;
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, energy_options);
+  ASSERT_GT(energy.prior_curvature().maxCoeff(), 0.0);
+  ASSERT_FALSE(energy.regularizer().pairs().empty());
+  SolverOptions options;
+  options.max_iterations = 3;
+  Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
+  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.3 * s);
+  const double start = LeastSquaresCost(&energy, k);
+  const SolverSummary summary = Solve(&energy, options, &k);
+  ASSERT_GE(summary.trace.size(), 2u);
+  // The trace holds -cost of Ceres' own problem: at the start and at the end.
+  EXPECT_NEAR(-summary.trace.front().energy, start, 1e-12 * start);
+  EXPECT_NEAR(-summary.trace.back().energy, summary.ls_cost_end, 1e-12 * start);
+  EXPECT_LT(summary.ls_cost_end, start);
+}
+
+// Counts the preparations it is asked for.
+class CountingTerm : public SimilarityTerm {
+ public:
+  double Evaluate(const Eigen::VectorXd&, Eigen::VectorXd*) const override { return 0.0; }
+  const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
+  void PrepareResiduals(const Eigen::VectorXd&, bool with_jacobians) override {
+    ++(with_jacobians ? with_jacobians_ : residuals_only_);
+  }
+  void BlockResiduals(int, double*, double*) const override {}
+  int with_jacobians_ = 0, residuals_only_ = 0;
+
+ private:
+  std::vector<ResidualBlock> blocks_;
+};
+
+// One preparation with Jacobians serves every later request at the same point, whether or not
+// Ceres says the point is new; a new point, or Jacobians after residuals only, prepares again.
+TEST(CeresCostTest, TheCallbackPreparesEachPointOnce) {
+  CountingTerm term;
+  Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.001);
+  double seconds = 0.0;
+  SharedEvaluationCallback callback(&term, &k, &seconds);
+  callback.PrepareForEvaluation(true, true);
+  callback.PrepareForEvaluation(false, true);
+  callback.PrepareForEvaluation(true, false);
+  EXPECT_EQ(term.with_jacobians_, 1);
+  EXPECT_EQ(term.residuals_only_, 0);
+  k[1] = 0.002;
+  callback.PrepareForEvaluation(false, true);
+  EXPECT_EQ(term.residuals_only_, 1);
+  callback.PrepareForEvaluation(true, true);
+  EXPECT_EQ(term.with_jacobians_, 2);
+  callback.PrepareForEvaluation(true, true);
+  EXPECT_EQ(term.with_jacobians_, 2);
 }
 
 class SolverTest : public ::testing::TestWithParam<std::string> {};

@@ -68,6 +68,26 @@ inline void ExpectErrorMentions(const std::function<void()>& action,
   }
 }
 
+// An independent base64 decoder: looks every character up in the alphabet string.
+inline std::string Base64Decode(const std::string& text) {
+  const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string bytes;
+  unsigned bits = 0;  // Only the low bit_count bits are pending.
+  int bit_count = 0;
+  for (char c : text) {
+    if (c == '=') break;
+    const size_t value = alphabet.find(c);
+    EXPECT_NE(value, std::string::npos) << "not base64: " << c;
+    bits = ((bits << 6) | static_cast<unsigned>(value)) & 0xfffu;
+    bit_count += 6;
+    if (bit_count >= 8) {
+      bit_count -= 8;
+      bytes.push_back(static_cast<char>((bits >> bit_count) & 0xff));
+    }
+  }
+  return bytes;
+}
+
 }  // namespace testing_util
 }  // namespace finecap
 

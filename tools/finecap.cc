@@ -56,7 +56,8 @@ const std::vector<Subcommand>& Subcommands() {
        {"config", "out", "set"}},
       {"probe",
        "Diagnostic: the configured energy along k = alpha * k_true on a frame with ground truth; "
-       "ends with alpha_optimum.",
+       "ends with alpha_optimum. Writes its plot and reference colours into --out, else into a "
+       "new folder under $TMPDIR (default /tmp), never into the current directory.",
        "finecap probe --config FILE --capture DIR [--frame N] [--out DIR]",
        [](const Config& config) { return RunProbe(config, FLAGS_frame); },
        {"config", "capture", "out", "frame", "set"}},

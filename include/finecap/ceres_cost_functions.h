@@ -1,7 +1,7 @@
 // The Ceres pieces of the least-squares form of the energy (solver.h), with hand-written
-// Jacobians: one cost function per residual block of the similarity, one per pair of neighbours
-// of the regulariser, and the evaluation callback that computes the similarity's residuals once
-// per evaluation point for all blocks.
+// Jacobians: one cost function per residual block of the similarity, one per surface Gaussian for
+// its prior and its share of the regulariser, and the evaluation callback that computes the
+// similarity's residuals once per evaluation point for all blocks.
 #ifndef FINECAP_CERES_COST_FUNCTIONS_H_
 #define FINECAP_CERES_COST_FUNCTIONS_H_
 
@@ -15,7 +15,8 @@
 
 namespace finecap {
 
-// Calls SimilarityTerm::PrepareResiduals at every new evaluation point. `k` is the vector whose
+// Calls SimilarityTerm::PrepareResiduals at every evaluation point that differs from the last one
+// prepared (or needs Jacobians the last preparation did not compute). `k` is the vector whose
 // entries are the problem's parameter blocks: Ceres has written the point there when it calls.
 // Time spent is added to *seconds.
 class SharedEvaluationCallback : public ceres::EvaluationCallback {
@@ -27,6 +28,7 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
   SimilarityTerm* term_;
   const Eigen::VectorXd* k_;
   double* seconds_;
+  Eigen::VectorXd prepared_;  // The point of the last preparation (empty before the first).
   bool have_jacobians_ = false;
 };
 
@@ -57,16 +59,29 @@ class IsolatedSimilarityBlockCost : public SimilarityBlockCost {
   Eigen::VectorXd k_;
 };
 
-// r = c (k_a - k_b), or r = c k_a when the neighbour is fixed at 0 (`fixed_neighbour`), with
-// c = 2 sqrt(w_reg T(delta)) u, so that 1/2 sum r^2 = w_reg E_reg (regularizer.h).
-class RegularizerPairCost : public ceres::CostFunction {
+// The quadratic terms that touch one surface Gaussian s, as one residual block: its pull towards
+// the input (r = sqrt(h_s) k_s, when h_s > 0) and the regulariser's pairs assigned to it
+// (r = c_j (k_s - k_j), or r = c_j k_s when the neighbour is fixed at 0, with
+// c_j = 2 sqrt(w_reg T(delta_sj)) u, so that 1/2 sum r^2 = w_reg E_reg, regularizer.h). Every
+// pair belongs to exactly one of its two Gaussians. One block per Gaussian instead of one per
+// pair and one per prior: a third of the residual blocks of the problem for Ceres to visit and
+// assemble; the residuals, and so the cost and every step, are the same.
+//
+// Parameter blocks: k_s first, then each free neighbour k_j in the order of `neighbours`.
+class SmoothnessBlockCost : public ceres::CostFunction {
  public:
-  RegularizerPairCost(double coefficient, bool fixed_neighbour);
+  struct Neighbour {
+    int parameter = -1;  // Index of k_j among the parameter blocks (>= 1), or -1 when fixed at 0.
+    double coefficient = 0.0;  // c_j.
+  };
+  // `prior_root` is sqrt(h_s), or 0 for no prior residual.
+  SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours, int num_free);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  double coefficient_;
+  double prior_root_;
+  std::vector<Neighbour> neighbours_;
 };
 
 }  // namespace finecap

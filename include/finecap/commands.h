@@ -20,8 +20,10 @@ int RunProbe(const Config& config, int frame);
 // against the capture's ground truth and writes output.dir/eval/: frame_<frame>.png (image,
 // input normals, refined normals of camera eval.camera), error_<frame>.png (|k - k_true| as a
 // heat map), rms.png and normal_error.png, metrics.json and report.html. Frames without ground
-// truth get pictures and null figures. Throws Error naming output.dir when it holds no refined
-// frame of the configured range.
+// truth get pictures and null figures. With validation.cameras, also the held-out score of the
+// input and the refined mesh (heldout_score.h) in metrics.json and the report, and
+// heldout_<frame>_<camera>.png per held-out view. Throws Error naming output.dir when it holds no
+// refined frame of the configured range.
 int RunEval(const Config& config);
 
 // Writes a refined run (output.dir) as a PC2 point cache and per-frame PLY files with the

@@ -11,6 +11,7 @@
 #include "finecap/compare_config.h"
 #include "finecap/config_schema.h"
 #include "finecap/frame_range.h"
+#include "finecap/heldout_score.h"
 #include "finecap/refine.h"
 #include "finecap/shard.h"
 #include "finecap/synth.h"
@@ -63,11 +64,23 @@ struct EvalConfig {
   std::string flow_cameras = "all";
 };
 
+// Cameras left out of the refinement to measure it by (heldout_score.h): `finecap refine` uses
+// them for nothing (not for the reference colours, not in the energy, not for visibility) and
+// scores each frame's input and refined surface in them; `finecap eval` reports the figures and
+// pictures. A name that is not a camera of the capture, or holding out every camera, is an error.
+struct ValidationConfig {
+  // Names of the held-out cameras; empty (default): none, and no held-out figures.
+  std::vector<std::string> cameras;
+  // How the score is measured.
+  HeldOutOptions score;
+};
+
 struct Config {
   CaptureConfig capture;
   OutputConfig output;
   RuntimeConfig runtime;
   EvalConfig eval;
+  ValidationConfig validation;
   // Index, in the capture's sorted frame list, of the frame whose images colour the surface
   // Gaussians. Default 0 (the paper: "typically the first frame").
   int reference_frame = 0;

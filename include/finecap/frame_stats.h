@@ -3,6 +3,7 @@
 #ifndef FINECAP_FRAME_STATS_H_
 #define FINECAP_FRAME_STATS_H_
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,10 +27,11 @@ struct FrameStats {
   double seconds_solve = 0.0;
   double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
   double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.
+  double seconds_heldout = 0.0;        // After the solve: the held-out score (validation.cameras).
   int surface_gaussians = 0;
   long image_gaussians = 0;
   long pairs = 0;
-  bool worse = false;       // The run's own energy says the frame got worse.
+  bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.
   bool kept_input = false;  // And the input surface was written instead.
   // Against ground truth, when the capture has it (NaN otherwise): RMS of k - k_true over the
   // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
@@ -38,6 +40,15 @@ struct FrameStats {
   // The same over the textureless region (NaN when the capture marks none).
   double rms_textureless_coarse_mm = 0.0;
   double rms_textureless_refined_mm = 0.0;
+  // In the held-out cameras (validation.cameras; heldout_score.h), NaN when there are none: the
+  // mean local NCC and mean absolute grey-level difference between each held-out image and the
+  // training views warped into it through the subdivided input mesh and through the refined
+  // mesh as solved (before refine.keep_input_if_worse puts the input back). A refined NCC below
+  // the input's flags the frame `worse`.
+  double heldout_ncc_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_ncc_refined = std::numeric_limits<double>::quiet_NaN();
+  double heldout_mad_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_mad_refined = std::numeric_limits<double>::quiet_NaN();
   // Cameras left out of this frame because their image could not be read
   // (capture.skip_unreadable_cameras); empty when every camera was used.
   std::vector<std::string> skipped_cameras;

@@ -68,6 +68,9 @@ class HtmlReport {
   // Embeds an 8- or 16-bit image with 1, 3 (BGR, OpenCV's order) or 4 channels, PNG-encoded.
   // Throws Error when it is empty or of another type.
   void AddImage(const cv::Mat& image, const std::string& caption = "");
+  // Inserts `html` as it is, not escaped: for generated fragments such as the 3D viewer
+  // (mesh_viewer.h). The caller vouches that it is well formed and self-contained.
+  void AddRawHtml(const std::string& html);
 
   // The whole document.
   std::string Html() const;

@@ -79,8 +79,9 @@ struct RefineOptions {
   // surface-colour similarity has no such shrink (configs/paper.yaml turns it on).
   bool bias_compensation = false;
   // When the solver ends with a lower energy than it started from (the run's own measure says
-  // the frame got worse), write the input surface for that frame instead. The stats record flags
-  // such frames either way. Default false.
+  // the frame got worse), write the input surface for that frame instead; `finecap refine` does
+  // the same when the held-out NCC (validation.cameras) of the result is below the input's. The
+  // stats record flags such frames either way. Default false.
   bool keep_input_if_worse = false;
   // Start each frame from the previous frame's k instead of from zero. Default false.
   bool warm_start = false;
@@ -175,6 +176,11 @@ struct FrameResult {
   double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
   double seconds_total = 0.0;        // The whole frame.
 };
+
+// Puts the input surface back into `result` (its refined mesh, normals and k, which becomes 0
+// wherever it was refined) and sets kept_input, for a frame that another measure than the energy
+// found worse. `fine_input` is the frame's subdivided input mesh.
+void KeepInputSurface(const Mesh& fine_input, FrameResult* result);
 
 // Where a frame's solve starts: `warm_start` when given and of the right size, else the plane
 // sweep's result (zero when the sweep is off).

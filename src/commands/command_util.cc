@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,10 +19,65 @@ namespace internal {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+bool IsHeldOut(const Config& config, const std::string& camera) {
+  const std::vector<std::string>& names = config.validation.cameras;
+  return std::find(names.begin(), names.end(), camera) != names.end();
+}
+
+// Every name of validation.cameras is a camera of the rig, and at least one camera is left to
+// refine with.
+void CheckHeldOutCameras(const Config& config, const Capture& capture) {
+  std::string rig;
+  for (const Camera& camera : capture.cameras()) rig += (rig.empty() ? "" : ", ") + camera.name;
+  for (const std::string& name : config.validation.cameras) {
+    bool found = false;
+    for (const Camera& camera : capture.cameras()) found = found || camera.name == name;
+    Require(
+        found, "validation.cameras",
+        "'" + name + "' is not a camera of " + capture.directory() + " (its cameras: " + rig + ")");
+  }
+  int training = 0;
+  for (const Camera& camera : capture.cameras()) training += IsHeldOut(config, camera.name) ? 0 : 1;
+  Require(training > 0, "validation.cameras",
+          "holds out every camera of " + capture.directory() + ": none is left to refine with");
+}
+
+}  // namespace
+
 Capture OpenConfiguredCapture(const Config& config) {
   Require(!config.capture.dir.empty(), "capture.dir",
           "no capture folder given (set capture.dir or pass --capture DIR)");
-  return Capture::Open(config.capture.dir);
+  Capture capture = Capture::Open(config.capture.dir);
+  CheckHeldOutCameras(config, capture);
+  return capture;
+}
+
+std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input) {
+  std::vector<CalibratedImage> held_out;
+  FrameInput training;
+  training.coarse = std::move(input->coarse);
+  for (size_t c = 0; c < input->cameras.size(); ++c) {
+    if (IsHeldOut(config, input->cameras[c].name)) {
+      held_out.push_back({input->cameras[c], input->images[c]});
+    } else {
+      training.cameras.push_back(input->cameras[c]);
+      training.images.push_back(input->images[c]);
+    }
+  }
+  *input = std::move(training);
+  Require(!input->cameras.empty(), "validation.cameras",
+          "no camera other than the held-out ones could be read");
+  return held_out;
+}
+
+std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
+  std::vector<CalibratedImage> views;
+  for (size_t c = 0; c < input.cameras.size(); ++c) {
+    views.push_back({input.cameras[c], input.images[c]});
+  }
+  return views;
 }
 
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture) {
@@ -144,8 +200,9 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
           "frame " + std::to_string(config.reference_frame) + " does not exist in " +
               capture->directory());
-  const FrameInput reference = ReadFrameInput(capture, config.reference_frame,
-                                              config.capture.skip_unreadable_cameras, nullptr);
+  FrameInput reference = ReadFrameInput(capture, config.reference_frame,
+                                        config.capture.skip_unreadable_cameras, nullptr);
+  TakeHeldOutViews(config, &reference);  // Held-out cameras colour nothing.
   WriteReferenceColors(path, ComputeSequenceColors(model, reference, config.refine));
   // As saved: every run and shard on this folder then starts from the very same colours.
   return ReadReferenceColors(path, model.num_fine_vertices());

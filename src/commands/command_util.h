@@ -9,14 +9,25 @@
 
 #include "finecap/capture.h"
 #include "finecap/config.h"
+#include "finecap/heldout_score.h"
 #include "finecap/refine.h"
 #include "finecap/scene_scale.h"
 
 namespace finecap {
 namespace internal {
 
-// Opens config.capture.dir; an Error names the key when it is empty.
+// Opens config.capture.dir; an Error names the key when it is empty, and names
+// validation.cameras when one of its names is not a camera of the capture or when it holds out
+// every camera.
 Capture OpenConfiguredCapture(const Config& config);
+
+// Removes the held-out cameras (validation.cameras) and their images from `input` and returns
+// them, in the rig's order: what is left is all that refinement may see. Throws Error when no
+// other camera is left (the others' images could not be read).
+std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input);
+
+// The cameras and images of `input`, for the held-out score.
+std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // The configured frames of `capture`; an Error when the range holds none of its frames.
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture);

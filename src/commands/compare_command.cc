@@ -37,8 +37,8 @@ std::vector<Variant> VariantConfigs(const Config& config) {
   return variants;
 }
 
-// Everything the reference colours depend on (ComputeSequenceColors): variants that agree on it
-// share one computation.
+// Everything the reference colours depend on (ComputeSequenceColors, and the held-out cameras it
+// must not see): variants that agree on it share one computation.
 std::string ReferenceColorRecipe(const Config& config) {
   const RefineOptions& refine = config.refine;
   std::ostringstream recipe;
@@ -49,6 +49,7 @@ std::string ReferenceColorRecipe(const Config& config) {
          << refine.image.split_threshold << " " << refine.visibility.depth_tolerance << " "
          << refine.visibility.max_view_angle_deg << " " << refine.visibility.border_margin << " "
          << refine.energy.overlap << " " << refine.energy.reach_sigmas;
+  for (const std::string& held_out : config.validation.cameras) recipe << "\n" << held_out;
   return recipe.str();
 }
 
@@ -103,8 +104,10 @@ VariantSummary MeasureVariant(const Variant& variant, const FrameRange& frames, 
     records.push_back(ReadFrameStats(out + "/frames/" + name + ".json"));
     const Eigen::VectorXd k =
         internal::ReadDisplacement(out + "/k/" + name + ".txt", model.num_fine_vertices());
-    paper_similarity.push_back(PaperSimilarityAtResult(
-        model, colors, internal::ReadFrameInput(capture, frame), config, records.back(), k));
+    FrameInput input = internal::ReadFrameInput(capture, frame);
+    internal::TakeHeldOutViews(config, &input);  // The energy as the variant's refine saw it.
+    paper_similarity.push_back(
+        PaperSimilarityAtResult(model, colors, input, config, records.back(), k));
   }
   return SummarizeVariant(variant.spec.name, records, paper_similarity);
 }

@@ -1,5 +1,6 @@
-// finecap eval: a refined run measured against the capture's ground truth; pictures, plots,
-// metrics.json and report.html in output.dir/eval/.
+// finecap eval: a refined run measured against the capture's ground truth (when it has one), by
+// optical flow and in the held-out cameras; pictures, plots, metrics.json and report.html in
+// output.dir/eval/.
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -10,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands/command_util.h"
+#include "commands/heldout_eval.h"
 #include "finecap/atomic_file.h"
 #include "finecap/commands.h"
 #include "finecap/error.h"
@@ -17,6 +19,7 @@
 #include "finecap/flow_evaluation.h"
 #include "finecap/html_report.h"
 #include "finecap/mesh_io.h"
+#include "finecap/mesh_viewer.h"
 #include "finecap/plot.h"
 #include "finecap/render.h"
 #include "io_util.h"
@@ -155,6 +158,7 @@ struct EvaluationRun {
   std::vector<EvaluationFigures> figures;
   std::vector<FlowComparison> flows;  // Per frame; empty sums when flow is not measured.
   FlowComparison pooled_flow;
+  std::vector<internal::HeldOutFrame> heldout;  // Per frame; empty without validation.cameras.
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
@@ -181,6 +185,11 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
                                                config.eval.camera, capture, &fields)
                             : FlowComparison());
   run->pooled_flow.Add(run->flows.back());
+  if (!config.validation.cameras.empty()) {
+    run->heldout.push_back(internal::EvaluateHeldOutFrame(
+        config, frame.name, internal::ReadFrameInput(capture, frame.index), input, refined,
+        eval_dir, &run->pictures));
+  }
   const Camera& camera = capture->cameras()[config.eval.camera];
   const cv::Mat image = capture->ReadImage(config.eval.camera, frame.index);
   const cv::Rect box = SubjectBox(camera, input, refined);
@@ -249,12 +258,14 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
-       << ",\n  " << FlowJson(run.pooled_flow, "\n  ")
+       << ",\n  " << FlowJson(run.pooled_flow, "\n  ") << ",\n  "
+       << internal::HeldOutPooledJson(run.heldout, "\n  ")
        << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
   for (size_t i = 0; i < run.names.size(); ++i) {
     json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
-         << ", " << FlowJson(run.flows[i], " ") << ", \"figures\": " << FiguresJson(run.figures[i])
-         << "}";
+         << ", " << FlowJson(run.flows[i], " ") << ", \"heldout\": "
+         << (run.heldout.empty() ? "null" : internal::HeldOutFrameJson(run.heldout[i]))
+         << ", \"figures\": " << FiguresJson(run.figures[i]) << "}";
   }
   json << "\n  ]\n}\n";
   return json.str();
@@ -367,10 +378,35 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
   WriteTextFileAtomically(path, csv.str());
 }
 
+// Frames the report's 3D view offers: enough to see the motion, few enough to keep the report
+// small (each adds two meshes' positions).
+constexpr int kViewerFrames = 5;
+
+// The report's 3D view: the input and refined meshes of up to kViewerFrames frames, evenly spaced
+// over the evaluated ones, seen first from the eval camera. Where three.js is absent a note takes
+// its place and a warning goes to stderr: the report is still written.
+std::string ViewerHtml(const std::vector<internal::RefinedFrame>& frames,
+                       const SequenceModel& model, const Camera& camera, Capture* capture) {
+  const std::optional<ThreeJsLibrary> library = FindThreeJs();
+  if (!library) {
+    std::cerr << "finecap eval: warning: three.js not found (install Debian's libjs-three or set "
+                 "FINECAP_THREE_JS_DIR); report.html has a note in place of the 3D view\n";
+    return MissingViewerHtml();
+  }
+  std::vector<ViewerFrame> shown;
+  for (int i : EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames)) {
+    const internal::RefinedFrame& frame = frames[i];
+    shown.push_back(
+        {frame.name, model.Subdivide(capture->ReadCoarseMesh(frame.index)), ReadMesh(frame.mesh)});
+  }
+  return MeshViewerHtml(shown, camera, *library);
+}
+
 void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
+                 const HeldOutOptions& heldout_options,
                  const std::vector<std::pair<std::string, std::string>>& plots,
                  const std::vector<std::pair<std::string, std::string>>& flow_plots,
-                 const std::string& path) {
+                 const std::string& viewer_html, const std::string& path) {
   const std::vector<std::string> header = {"",
                                            "vertices",
                                            "RMS input mm",
@@ -397,9 +433,12 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
     frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
   }
   report.AddTable(header, frame_rows, "Per frame, all refined vertices");
+  report.AddSection("3D view");
+  report.AddRawHtml(viewer_html);
   report.AddSection("Optical flow");
   AddFlowTable(run, &report);
   for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
+  if (!run.heldout.empty()) internal::AddHeldOutSection(run.heldout, heldout_options, &report);
   if (!plots.empty()) report.AddSection("Over the frames");
   for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
   report.AddSection("Pictures");
@@ -436,7 +475,9 @@ int RunEval(const Config& configured) {
   const EvaluationFigures sequence = ComputeEvaluationFigures(run.pooled);
   WriteTextFileAtomically(eval_dir + "/metrics.json", MetricsJson(run, sequence));
   WriteFlowCsv(run, eval_dir + "/flow.csv");
-  WriteReport(run, sequence, WritePlots(run, eval_dir), WriteFlowPlot(run, eval_dir),
+  WriteReport(run, sequence, config.validation.score, WritePlots(run, eval_dir),
+              WriteFlowPlot(run, eval_dir),
+              ViewerHtml(frames, model, capture.cameras()[config.eval.camera], &capture),
               eval_dir + "/report.html");
 
   std::cout.precision(3);
@@ -447,6 +488,12 @@ int RunEval(const Config& configured) {
               << " mm; detail recovered " << 100.0 * sequence.all.detail_recovered
               << " %; normal error " << sequence.all.normal_error_coarse_deg << " -> "
               << sequence.all.normal_error_refined_deg << " degrees\n";
+  }
+  if (!run.heldout.empty()) {
+    const std::vector<SurfaceScore> pooled = internal::PooledHeldOutScore(run.heldout);
+    std::cout << "Held-out cameras: NCC input " << pooled[0].ncc << ", refined " << pooled[1].ncc
+              << "; MAD input " << pooled[0].mad << ", refined " << pooled[1].mad
+              << " grey levels\n";
   }
   if (flow) {
     std::cout << "Optical flow to the images: input " << run.pooled_flow.coarse.mean_px()

@@ -12,15 +12,22 @@
 namespace finecap {
 namespace {
 
-void PrintCameras(const Capture& capture, const ProblemSize& size) {
+// `training` are the cameras refine uses (size.visible_per_camera follows them); the held-out ones
+// are listed after them.
+void PrintCameras(const Capture& capture, const std::vector<Camera>& training,
+                  const std::vector<CalibratedImage>& held_out, const ProblemSize& size) {
   std::cout << "cameras: " << capture.num_cameras() << ", read from " << capture.rig_source()
             << "\n";
-  for (int c = 0; c < capture.num_cameras(); ++c) {
-    const Camera& camera = capture.rig()[c];
+  for (size_t c = 0; c < training.size(); ++c) {
+    const Camera& camera = training[c];
     std::cout << "  " << camera.name << ": " << camera.width << "x" << camera.height << ", focal "
               << camera.focal() << " px"
               << (camera.HasDistortion() ? ", lens distortion (undistorted on load)" : "")
               << ", sees " << size.visible_per_camera[c] << " fine vertices\n";
+  }
+  for (const CalibratedImage& view : held_out) {
+    std::cout << "  " << view.camera.name << ": held out (validation.cameras), scored by refine "
+              << "and eval only\n";
   }
 }
 
@@ -31,10 +38,11 @@ void PrintFrames(const Capture& capture, const FrameRange& frames, int reference
             << capture.frame_name(reference_frame) << "\n";
 }
 
-void PrintWarnings(const Config& config, const Capture& capture, const ProblemSize& size) {
-  for (int c = 0; c < capture.num_cameras(); ++c) {
+void PrintWarnings(const Config& config, const std::vector<Camera>& training,
+                   const ProblemSize& size) {
+  for (size_t c = 0; c < training.size(); ++c) {
     if (size.visible_per_camera[c] > 0) continue;
-    std::cout << "warning: camera " << capture.cameras()[c].name
+    std::cout << "warning: camera " << training[c].name
               << " sees no vertex of the mesh (behind it, out of its image, or every vertex "
                  "beyond the view-angle cap): check its calibration and units\n";
   }
@@ -58,14 +66,16 @@ int RunInfo(const Config& configured) {
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.mesh_path(0));
-  const ReferenceColors colors = ComputeSequenceColors(
-      model, internal::ReadFrameInput(&capture, config.reference_frame), config.refine);
+  FrameInput reference = internal::ReadFrameInput(&capture, config.reference_frame);
+  internal::TakeHeldOutViews(config, &reference);  // As refine colours the surface.
+  const ReferenceColors colors = ComputeSequenceColors(model, reference, config.refine);
   const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
-  const ProblemSize size =
-      EstimateProblemSize(model, colors, internal::ReadFrameInput(&capture, first), config.refine);
+  FrameInput input = internal::ReadFrameInput(&capture, first);
+  const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
+  const ProblemSize size = EstimateProblemSize(model, colors, input, config.refine);
 
   std::cout << "capture: " << capture.directory() << "\n";
-  PrintCameras(capture, size);
+  PrintCameras(capture, input.cameras, held_out, size);
   PrintFrames(capture, frames, config.reference_frame);
   const Mesh coarse = capture.ReadCoarseMesh(0);
   std::cout << "mesh: " << coarse.num_vertices() << " vertices, " << coarse.num_faces()
@@ -95,7 +105,7 @@ int RunInfo(const Config& configured) {
             << " MB, about " << internal::RoundedSeconds(size.seconds_per_frame) << " ("
             << internal::RoundedSeconds(size.seconds_per_frame * frames.size()) << " for "
             << frames.size() << " frames)\n";
-  PrintWarnings(config, capture, size);
+  PrintWarnings(config, input.cameras, size);
   return 0;
 }
 

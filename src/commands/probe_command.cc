@@ -1,7 +1,12 @@
 // finecap probe: the configured energy along k = alpha * k_true on a frame with ground truth.
 // An energy that describes the images well peaks at alpha = 1; one that prefers flatter surfaces
 // peaks below it. Every change to the energy is judged by this diagnostic.
+#include <stdlib.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 
 #include "commands/command_util.h"
@@ -34,6 +39,24 @@ double Optimum(const std::vector<ProbeSample>& samples, double ProbeSample::*val
   return samples[best].alpha + 0.5 * h * (y0 - y2) / curvature;
 }
 
+// The folder of --out (output.dir); without one, a new folder under the system's temporary
+// folder ($TMPDIR, else /tmp): the probe's plot and reference colours are a diagnostic, and the
+// current directory is the user's, not the probe's. A new folder each run, so that reference
+// colours cached for another capture are never reused.
+std::string ProbeOutputFolder(const Config& config, const Capture& capture) {
+  if (!config.output.dir.empty()) return internal::PrepareOutputFolder(config, capture);
+  std::error_code error;
+  const std::filesystem::path temp = std::filesystem::temp_directory_path(error);
+  Require(!error, "TMPDIR",
+          "no temporary folder for the probe's files (" + error.message() + "): pass --out DIR");
+  std::string folder = (temp / "finecap-probe-XXXXXX").string();
+  Require(mkdtemp(folder.data()) != nullptr, folder,
+          std::string("cannot create the probe's folder: ") + std::strerror(errno) +
+              " (pass --out DIR)");
+  std::printf("probe: no --out given, writing into %s\n", folder.c_str());
+  return folder;
+}
+
 }  // namespace
 
 int RunProbe(const Config& configured, int frame_index) {
@@ -47,11 +70,11 @@ int RunProbe(const Config& configured, int frame_index) {
               capture.frame_name(frame) + ".ply): the probe needs a synthetic capture");
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
-  const std::string out =
-      config.output.dir.empty() ? std::string(".") : internal::PrepareOutputFolder(config, capture);
+  const std::string out = ProbeOutputFolder(config, capture);
   const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
       config, model, &capture, out + "/reference_colors.txt");
-  const FrameInput input = internal::ReadFrameInput(&capture, frame);
+  FrameInput input = internal::ReadFrameInput(&capture, frame);
+  internal::TakeHeldOutViews(config, &input);  // The energy as refine sees it.
   PreparedFrame prepared = PrepareFrame(model, colors, input, config.refine);
   const FrameEnergy& energy = *prepared.energy;
 

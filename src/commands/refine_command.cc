@@ -1,6 +1,7 @@
 // finecap refine: every configured frame of a capture, refined and written to output.dir.
 #include <charconv>
 #include <cmath>
+#include <future>
 #include <iostream>
 #include <sstream>
 
@@ -10,6 +11,7 @@
 #include "finecap/commands.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
+#include "finecap/heldout_score.h"
 #include "finecap/mesh_io.h"
 #include "finecap/metrics.h"
 #include "finecap/problem_size.h"
@@ -79,20 +81,94 @@ void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, co
       1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
 }
 
+// The held-out score of the frame's input and of its result (as solved), into `stats`; a result
+// whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
+// replaced by the input.
+void ScoreInHeldOutViews(const Config& config, const SequenceModel& model, const FrameInput& input,
+                         const std::vector<CalibratedImage>& held_out, FrameResult* result,
+                         FrameStats* stats) {
+  if (held_out.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh fine_input = model.Subdivide(input.coarse);
+  const HeldOutScore score =
+      ScoreHeldOutViews(internal::CalibratedImagesOf(input), held_out,
+                        {&fine_input, &result->refined}, config.validation.score);
+  stats->heldout_ncc_input = score.mean[0].ncc;
+  stats->heldout_ncc_refined = score.mean[1].ncc;
+  stats->heldout_mad_input = score.mean[0].mad;
+  stats->heldout_mad_refined = score.mean[1].mad;
+  stats->seconds_heldout =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
+  result->worse = stats->worse = true;
+  if (config.refine.keep_input_if_worse && !result->kept_input) {
+    KeepInputSurface(fine_input, result);
+    stats->kept_input = true;
+  }
+}
+
 // The size of the first frame's problem and what it forecasts, before the long part of the run.
 void PrintProblemSize(const Config& config, const SequenceModel& model,
                       const ReferenceColors& colors, Capture* capture, int first_frame,
                       int frames) {
-  const ProblemSize size = EstimateProblemSize(
-      model, colors, internal::ReadFrameInput(capture, first_frame), config.refine);
-  const Camera& camera = capture->cameras().front();
-  std::cerr << "finecap refine: " << frames << " frames, " << capture->num_cameras()
-            << " cameras of " << camera.width << "x" << camera.height << ", "
-            << size.num_surface_gaussians << " surface Gaussians (of " << size.num_fine_vertices
+  FrameInput first = internal::ReadFrameInput(capture, first_frame);
+  internal::TakeHeldOutViews(config, &first);  // Refine never sees them.
+  const ProblemSize size = EstimateProblemSize(model, colors, first, config.refine);
+  const Camera& camera = first.cameras.front();
+  std::cerr << "finecap refine: " << frames << " frames, " << first.cameras.size() << " cameras of "
+            << camera.width << "x" << camera.height << ", " << size.num_surface_gaussians
+            << " surface Gaussians (of " << size.num_fine_vertices
             << " vertices after subdivision), about " << internal::RoundedCount(size.num_pairs)
             << " pairs; expected peak memory " << std::lround(size.peak_memory_mb) << " MB, about "
             << internal::RoundedSeconds(size.seconds_per_frame) << " per frame\n";
 }
+
+// Reads frames' inputs (the coarse mesh, every camera's image decoded and undistorted) one frame
+// ahead on a thread of its own, so that reading the next frame overlaps solving this one and both
+// cores stay busy. Only this reader reads images from the capture while it lives; at most one
+// frame is read ahead (bounded memory).
+class FrameReader {
+ public:
+  FrameReader(Capture* capture, bool skip_unreadable)
+      : capture_(capture), skip_unreadable_(skip_unreadable) {}
+
+  // Starts reading `frame` in the background (after any read still under way).
+  void ReadAhead(int frame) {
+    if (pending_.valid()) return;
+    pending_frame_ = frame;
+    pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+  }
+
+  // The input of `frame`: the one read ahead when it is that frame (its errors are thrown here),
+  // else read now. The cameras skipped go to *skipped.
+  FrameInput Take(int frame, std::vector<std::string>* skipped) {
+    if (pending_.valid() && pending_frame_ == frame) {
+      Frame read = pending_.get();
+      *skipped = std::move(read.skipped);
+      return std::move(read.input);
+    }
+    pending_ = {};  // Waits for a read of another frame, and drops it.
+    Frame read = Read(frame);
+    *skipped = std::move(read.skipped);
+    return std::move(read.input);
+  }
+
+ private:
+  struct Frame {
+    FrameInput input;
+    std::vector<std::string> skipped;
+  };
+  Frame Read(int frame) {
+    Frame read;
+    read.input = internal::ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
+    return read;
+  }
+
+  Capture* capture_;
+  bool skip_unreadable_;
+  int pending_frame_ = -1;
+  std::future<Frame> pending_;
+};
 
 }  // namespace
 
@@ -120,6 +196,7 @@ int RunRefine(const Config& configured) {
   PrintProblemSize(config, model, colors, &capture, frames.begin, frames.size());
 
   internal::Progress progress(frames.size());
+  FrameReader reader(&capture, config.capture.skip_unreadable_cameras);
   double sum_coarse2 = 0.0, sum_refined2 = 0.0;
   int measured = 0;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
@@ -131,8 +208,16 @@ int RunRefine(const Config& configured) {
     }
     const auto start = std::chrono::steady_clock::now();
     std::vector<std::string> skipped;
-    const FrameInput input =
-        internal::ReadFrameInput(&capture, frame, config.capture.skip_unreadable_cameras, &skipped);
+    FrameInput input = reader.Take(frame, &skipped);
+    const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
+    for (int next = frame + 1; next < frames.end; ++next) {
+      if (internal::FrameDone(
+              internal::FrameFilesIn(out, capture.frame_name(next), config.output.mesh_format))) {
+        continue;
+      }
+      reader.ReadAhead(next);
+      break;
+    }
     const Eigen::VectorXd warm_start = WarmStart(out, capture, frame, config, model);
     FrameResult result = warm_start.size() > 0
                              ? RefineFrameFrom(model, colors, input, config.refine, warm_start)
@@ -145,6 +230,7 @@ int RunRefine(const Config& configured) {
 
     FrameStats stats = MakeFrameStats(name, config.refine, result);
     stats.skipped_cameras = skipped;
+    ScoreInHeldOutViews(config, model, input, held_out, &result, &stats);
     AddGroundTruthErrors(capture, model, input.coarse, frame, regions, result, &stats);
     const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
     WriteMesh(files.mesh, result.refined, {result.normals, {}, quality},
@@ -160,7 +246,11 @@ int RunRefine(const Config& configured) {
     std::ostringstream detail;
     detail.precision(3);
     detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
-           << " iterations" << (stats.worse ? ", WORSE" : "");
+           << " iterations";
+    if (std::isfinite(stats.heldout_ncc_input)) {
+      detail << ", held-out NCC " << stats.heldout_ncc_input << " -> " << stats.heldout_ncc_refined;
+    }
+    detail << (stats.worse ? ", WORSE" : "") << (stats.kept_input ? " (input kept)" : "");
     if (std::isfinite(stats.rms_refined_mm)) {
       detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
       sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;

@@ -1,5 +1,8 @@
 #include "finecap/ceres_cost_functions.h"
 
+#include <algorithm>
+#include <utility>
+
 #include "solvers/solvers_internal.h"
 
 namespace finecap {
@@ -10,10 +13,17 @@ SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const E
 
 void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
                                                     bool new_evaluation_point) {
-  // A residual-only preparation cannot serve a later Jacobian request at the same point.
-  if (!new_evaluation_point && (have_jacobians_ || !evaluate_jacobians)) return;
+  // Ceres' trust region with bounds evaluates each new point up to three times: the projected
+  // line search's first trial (with Jacobians), the candidate's cost (residuals only), and, once
+  // the step is taken, the Jacobians again; only the last says it is the same point. Comparing
+  // the point itself lets one preparation with Jacobians serve all three. A residual-only
+  // preparation cannot serve a later Jacobian request at the same point.
+  const bool same_point =
+      !new_evaluation_point || (prepared_.size() == k_->size() && prepared_ == *k_);
+  if (same_point && (have_jacobians_ || !evaluate_jacobians)) return;
   const internal::Stopwatch clock;
   term_->PrepareResiduals(*k_, evaluate_jacobians);
+  prepared_ = *k_;
   have_jacobians_ = evaluate_jacobians;
   *seconds_ += clock.Seconds();
 }
@@ -57,19 +67,39 @@ bool IsolatedSimilarityBlockCost::Evaluate(double const* const* parameters, doub
   return SimilarityBlockCost::Evaluate(parameters, residuals, jacobians);
 }
 
-RegularizerPairCost::RegularizerPairCost(double coefficient, bool fixed_neighbour)
-    : coefficient_(coefficient) {
-  set_num_residuals(1);
-  mutable_parameter_block_sizes()->assign(fixed_neighbour ? 1 : 2, 1);
+SmoothnessBlockCost::SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours,
+                                         int num_free)
+    : prior_root_(prior_root), neighbours_(std::move(neighbours)) {
+  set_num_residuals(static_cast<int>(neighbours_.size()) + (prior_root_ > 0.0 ? 1 : 0));
+  mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
-bool RegularizerPairCost::Evaluate(double const* const* parameters, double* residuals,
+bool SmoothnessBlockCost::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const bool pair = parameter_block_sizes().size() == 2;
-  residuals[0] = coefficient_ * (parameters[0][0] - (pair ? parameters[1][0] : 0.0));
-  if (jacobians == nullptr) return true;
-  if (jacobians[0] != nullptr) jacobians[0][0] = coefficient_;
-  if (pair && jacobians[1] != nullptr) jacobians[1][0] = -coefficient_;
+  const int num_parameters = static_cast<int>(parameter_block_sizes().size());
+  const double k = parameters[0][0];
+  if (jacobians != nullptr) {
+    for (int p = 0; p < num_parameters; ++p) {
+      if (jacobians[p] != nullptr) std::fill_n(jacobians[p], num_residuals(), 0.0);
+    }
+  }
+  int r = 0;
+  if (prior_root_ > 0.0) {
+    residuals[r] = prior_root_ * k;
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][r] = prior_root_;
+    ++r;
+  }
+  for (const Neighbour& neighbour : neighbours_) {
+    const double other = neighbour.parameter >= 0 ? parameters[neighbour.parameter][0] : 0.0;
+    residuals[r] = neighbour.coefficient * (k - other);
+    if (jacobians != nullptr) {
+      if (jacobians[0] != nullptr) jacobians[0][r] = neighbour.coefficient;
+      if (neighbour.parameter >= 0 && jacobians[neighbour.parameter] != nullptr) {
+        jacobians[neighbour.parameter][r] = -neighbour.coefficient;
+      }
+    }
+    ++r;
+  }
   return true;
 }
 

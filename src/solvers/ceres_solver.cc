@@ -1,6 +1,9 @@
 // The least-squares form of the energy as a Ceres problem with hand-written Jacobians.
+#include <cmath>
 #include <memory>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include <ceres/ceres.h>
 
@@ -10,6 +13,37 @@
 namespace finecap {
 namespace internal {
 namespace {
+
+// The prior and the regulariser, one block per surface Gaussian (SmoothnessBlockCost): each pair
+// of neighbours goes to the block of its first Gaussian, `pair.a`.
+void AddSmoothnessResiduals(const FrameEnergy& energy, Eigen::VectorXd* k,
+                            ceres::Problem* problem) {
+  const Regularizer& regularizer = energy.regularizer();
+  const Eigen::VectorXd& prior = energy.prior_curvature();
+  const double w_reg = energy.options().w_reg;
+  std::vector<std::vector<SmoothnessBlockCost::Neighbour>> neighbours(k->size());
+  std::vector<std::vector<double*>> blocks(k->size());
+  for (int s = 0; s < k->size(); ++s) blocks[s].push_back(&(*k)[s]);
+  if (w_reg > 0.0) {
+    for (const Regularizer::Pair& pair : regularizer.pairs()) {
+      SmoothnessBlockCost::Neighbour neighbour;
+      neighbour.coefficient = 2.0 * std::sqrt(w_reg * pair.weight) * regularizer.unit_scale();
+      if (pair.b >= 0) {
+        neighbour.parameter = static_cast<int>(blocks[pair.a].size());
+        blocks[pair.a].push_back(&(*k)[pair.b]);
+      }
+      neighbours[pair.a].push_back(neighbour);
+    }
+  }
+  for (int s = 0; s < k->size(); ++s) {
+    const double prior_root = prior[s] > 0.0 ? std::sqrt(prior[s]) : 0.0;
+    if (prior_root == 0.0 && neighbours[s].empty()) continue;
+    const int num_free = static_cast<int>(blocks[s].size()) - 1;
+    problem->AddResidualBlock(
+        new SmoothnessBlockCost(prior_root, std::move(neighbours[s]), num_free), nullptr,
+        blocks[s]);
+  }
+}
 
 void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* problem) {
   const double k_max = energy->options().k_max;
@@ -25,21 +59,7 @@ void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* probl
     for (int s : term.residual_blocks()[b].parameters) blocks.push_back(&(*k)[s]);
     problem->AddResidualBlock(new SimilarityBlockCost(term, b), nullptr, blocks);
   }
-  const Regularizer& regularizer = energy->regularizer();
-  const Eigen::VectorXd& prior = energy->prior_curvature();
-  for (int s = 0; s < k->size(); ++s) {
-    if (prior[s] <= 0.0) continue;
-    problem->AddResidualBlock(new RegularizerPairCost(std::sqrt(prior[s]), true), nullptr,
-                              &(*k)[s]);
-  }
-  const double w_reg = energy->options().w_reg;
-  if (w_reg <= 0.0) return;
-  for (const Regularizer::Pair& pair : regularizer.pairs()) {
-    const double coefficient = 2.0 * std::sqrt(w_reg * pair.weight) * regularizer.unit_scale();
-    blocks.assign(1, &(*k)[pair.a]);
-    if (pair.b >= 0) blocks.push_back(&(*k)[pair.b]);
-    problem->AddResidualBlock(new RegularizerPairCost(coefficient, pair.b < 0), nullptr, blocks);
-  }
+  AddSmoothnessResiduals(*energy, k, problem);
 }
 
 ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {

@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# How close a synth_skirt frame (8 cameras of 1004 x 1004, ~10k surface Gaussians) comes to its
+# lower bound on this machine. The bound: the evaluations the solve needs, each one pass over the
+# pairs with Jacobians (build/energy_benchmark, all threads), plus reading the frame's images
+# (decoding and undistortion, one thread). Beside it the measured per-stage times of
+# `finecap refine` (medians over the frames of stats.jsonl).
+#
+#   bash bench/frame_limit.sh            # 10 frames; FRAMES=5 for a quicker look
+#   SOLVER=gradient-ascent bash bench/frame_limit.sh
+#
+# Prints one "name: value" a line, seconds per frame unless the name says otherwise.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+frames=${FRAMES:-10}
+solver=${SOLVER:-ceres}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+[ -x build/finecap ] && [ -x build/energy_benchmark ] || bash scripts/build.sh >/dev/null
+build/finecap synth --config configs/synth_skirt.yaml --out "$work/capture" \
+  --set "synth.num_frames=$frames" >/dev/null
+start=$(date +%s.%N)
+build/finecap refine --capture "$work/capture" --out "$work/out" --solver "$solver" \
+  >/dev/null 2>&1
+end=$(date +%s.%N)
+
+# Median over the frames of a figure in stats.jsonl.
+median_of() {
+  grep -o "\"$1\": [0-9.eE+-]*" "$work/out/stats.jsonl" | awk '{ print $2 }' | sort -g |
+    awk '{ v[NR] = $1 } END { printf "%.3f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+
+# Medians of 5 repetitions, milliseconds.
+bench=$(build/energy_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
+  --benchmark_filter='BM_EnergyAndGradient/surface_color/0|BM_ReadFrame|BM_PrepareFrame' 2>/dev/null)
+ms_of() { echo "$bench" | awk -v n="$1" '$1 ~ n && $1 ~ /_median$/ { print $2; exit }'; }
+evaluation_ms=$(ms_of 'BM_EnergyAndGradient/surface_color/0')
+read_ms=$(ms_of 'BM_ReadFrame')
+prepare_ms=$(ms_of 'BM_PrepareFrame')
+
+evaluations=$(median_of evaluations)
+total=$(median_of seconds)
+echo "solver: $solver"
+echo "frames: $frames"
+echo "evaluations_per_frame: $evaluations"
+echo "one_pass_with_jacobians_ms: $evaluation_ms"
+echo "reading_a_frame_ms: $read_ms"
+echo "preparing_a_frame_ms: $prepare_ms"
+bound=$(awk -v e="$evaluations" -v p="$evaluation_ms" -v r="$read_ms" \
+  'BEGIN { printf "%.3f", (e * p + r) / 1000 }')
+echo "lower_bound_s: $bound"
+echo "measured_frame_s: $total"
+echo "measured_preparation_s: $(median_of seconds_preparation)"
+echo "measured_solve_s: $(median_of seconds_solve)"
+echo "measured_evaluation_s: $(median_of seconds_evaluation)"
+echo "measured_linear_solver_s: $(median_of seconds_linear_solver)"
+echo "measured_run_frames_per_minute: $(echo "$start $end" |
+  awk -v f="$frames" '{ printf "%.1f", 60 * f / ($2 - $1) }')"
+echo "frame_over_bound: $(awk -v t="$total" -v b="$bound" 'BEGIN { printf "%.2f", t / b }')"

@@ -1,0 +1,49 @@
+// The report's 3D view seen in a browser: finecap eval's report.html of a tiny refined run, opened
+// in headless Chromium by scripts/check-report.sh, must show a shaded mesh in both halves of the
+// viewer's canvas (not a blank one). Skipped with a message where three.js is not installed or
+// Chromium cannot be installed or started.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "finecap/commands.h"
+#include "finecap/config.h"
+#include "finecap/mesh_viewer.h"
+#include "finecap/synth.h"
+#include "test_util.h"
+#include "tiny_synth.h"
+
+namespace finecap {
+namespace {
+
+constexpr int kChromiumUnavailable = 77;  // scripts/check-report.sh's exit code.
+
+TEST(ReportViewerTest, ChromiumShowsAShadedMeshInBothHalves) {
+  if (!FindThreeJs()) GTEST_SKIP() << "three.js not installed (Debian's libjs-three)";
+  const std::string root = testing_util::MakeTempDir("report_viewer");
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), root + "/capture");
+  Config config;
+  config.capture.dir = root + "/capture";
+  config.output.dir = root + "/out";
+  config.runtime.threads = 1;
+  config.refine.solver.max_iterations = 5;
+  config.refine.solver.num_threads = 1;
+  config.eval.flow = "none";
+  ASSERT_EQ(RunRefine(config), 0);
+  ASSERT_EQ(RunEval(config), 0);
+  const std::string command = "bash " FINECAP_SOURCE_DIR "/scripts/check-report.sh " + root +
+                              "/out/eval/report.html " + root + "/shot.png > " + root +
+                              "/check.log 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << command;
+  const std::string log = testing_util::FileBytes(root + "/check.log");
+  if (WEXITSTATUS(status) == kChromiumUnavailable) GTEST_SKIP() << log;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << log;
+  EXPECT_NE(log.find("check-report: 3D view: input"), std::string::npos) << log;
+}
+
+}  // namespace
+}  // namespace finecap
