@@ -53,9 +53,9 @@ void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::V
   if (pooled) z_dot_dq.setConstant(z_dot_dq.mean());
   dz->resize(n);
   for (int m = 0; m < n; ++m) {
-    (*dz)[m] = (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) *
-                inverse_deviation)
-                   .matrix();
+    (*dz)[m] =
+        (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) * inverse_deviation)
+            .matrix();
   }
 }
 
@@ -139,9 +139,12 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
   for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) weights_[b] = PatchContrast(b);
 }
 
+int ConsensusSimilarity::NumTableNodes(double sigma_hat, double k_max) {
+  return static_cast<int>(std::ceil(2.0 * k_max / (sigma_hat / kNodesPerSigma))) + 1;
+}
+
 void ConsensusSimilarity::BuildTables(double k_max) {
-  node_step_ = surface_.sigma_hat / kNodesPerSigma;
-  num_nodes_ = static_cast<int>(std::ceil(2.0 * k_max / node_step_)) + 1;
+  num_nodes_ = NumTableNodes(surface_.sigma_hat, k_max);
   node_step_ = 2.0 * k_max / (num_nodes_ - 1);
   node_k0_ = -k_max;
   table_.resize(views_.size());
@@ -156,9 +159,11 @@ void ConsensusSimilarity::BuildTables(double k_max) {
       const int j = view.pairs.surface_ids[row];
       for (int g = 0; g < num_nodes_; ++g) {
         const long entry = long(row) * num_nodes_ + g;
-        table_[c][entry] = ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_,
-                                             form_, surface_.colors[j].cast<double>(),
-                                             &table_derivative_[c][entry]);
+        Eigen::Vector3d derivative;
+        table_[c][entry] = ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_, form_,
+                                             surface_.colors[j].cast<double>(), &derivative)
+                               .cast<float>();
+        table_derivative_[c][entry] = derivative.cast<float>();
       }
     }
   }
@@ -187,10 +192,10 @@ Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
   const int g = std::min(static_cast<int>(x), num_nodes_ - 2);
   const double t = x - g, t2 = t * t, t3 = t2 * t;
   const long entry = long(row) * num_nodes_ + g;
-  const Eigen::Vector3d& p0 = table_[c][entry];
-  const Eigen::Vector3d& p1 = table_[c][entry + 1];
-  const Eigen::Vector3d m0 = node_step_ * table_derivative_[c][entry];
-  const Eigen::Vector3d m1 = node_step_ * table_derivative_[c][entry + 1];
+  const Eigen::Vector3d p0 = table_[c][entry].cast<double>();
+  const Eigen::Vector3d p1 = table_[c][entry + 1].cast<double>();
+  const Eigen::Vector3d m0 = node_step_ * table_derivative_[c][entry].cast<double>();
+  const Eigen::Vector3d m1 = node_step_ * table_derivative_[c][entry + 1].cast<double>();
   if (derivative != nullptr) {
     const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
     derivative->setZero();
@@ -251,7 +256,8 @@ void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* ja
   if (options_.robust_fraction > 0.0) {
     // The level of disagreement of unrelated patches: each normalised channel has unit
     // variance, so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
-    const double unrelated = 3.0 * n * (num_cameras - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
+    const double unrelated =
+        3.0 * n * (num_cameras - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
     Robustify(options_.robust_fraction * unrelated, blocks_[b].num_residuals, residuals, jacobian);
   }
 }

@@ -1,5 +1,7 @@
 #include "finecap/problem_size.h"
 
+#include "finecap/consensus_similarity.h"
+
 #include <algorithm>
 
 #include "finecap/frame_energy.h"
@@ -16,8 +18,14 @@ constexpr int kSampledSurfaceGaussians = 3000;
 // subdivision levels and view-angle caps; 0.35 M to 85 M pairs, 115 MB to 890 MB), every one
 // within 4 % of its measured peak. The image Gaussians' own share is too small to measure.
 constexpr double kBaseMegabytes = 88.0;  // The process: code, libraries, thread stacks, allocator.
-constexpr double kBytesPerPixel = 5.5;   // The 8-bit images and the buffers of one at a time.
-constexpr double kBytesPerPair = 8.0;    // The image Gaussian's id and the pair's colour weight.
+constexpr double kBytesPerPixel = 5.5;
+// The next frame's 8-bit images, read while this one is solved.
+constexpr double kBytesPerPixelReadAhead = 3.0;
+// The consensus similarity's patch residuals, Jacobians and member rows, per surface Gaussian and
+// camera that sees it.
+constexpr double kConsensusBytesPerObservation =
+    400.0;                             // The 8-bit images and the buffers of one at a time.
+constexpr double kBytesPerPair = 8.0;  // The image Gaussian's id and the pair's colour weight.
 // Residual blocks, neighbourhoods, the regulariser and the solver's sparse matrices, which grow
 // with the surface Gaussians (not with the cameras that see them).
 constexpr double kBytesPerSurfaceGaussian = 3900.0;
@@ -67,10 +75,18 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     size.num_pixels += double(frame.cameras[c].width) * frame.cameras[c].height;
   }
 
-  size.peak_memory_mb =
-      kBaseMegabytes + (size.num_pixels * kBytesPerPixel + size.num_pairs * kBytesPerPair +
-                        size.num_surface_gaussians * kBytesPerSurfaceGaussian) /
-                           1e6;
+  double bytes = size.num_pixels * (kBytesPerPixel + kBytesPerPixelReadAhead) +
+                 size.num_pairs * kBytesPerPair +
+                 size.num_surface_gaussians * kBytesPerSurfaceGaussian;
+  if (options.energy.similarity == "consensus") {
+    // Its colour tables (value and derivative, 3 floats each, per node) and the residuals and
+    // Jacobians of the patches (3 channels of about 7 members, two doubles each) per
+    // observation, and the sweep's cost matrix and its smoothing copy.
+    const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
+    bytes += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation) +
+             size.num_surface_gaussians * options.sweep.samples * 16.0;
+  }
+  size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
   size.seconds_per_frame =
       size.num_pairs * kSecondsPerPair + size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
   return size;

@@ -46,10 +46,10 @@ double MedianPixelFootprint(const Mesh& mesh, const std::vector<Camera>& cameras
   return *middle;
 }
 
-// Replaces `*value` by factor * scene length when `from_scene`, and reports it.
+// Replaces `*value` by max(factor * scene length, at_least) when `from_scene`, and reports it.
 ChosenLength Choose(const std::string& key, double factor, double scene_length, double* value,
-                    bool from_scene) {
-  if (from_scene) *value = factor * scene_length;
+                    bool from_scene, double at_least = 0.0) {
+  if (from_scene) *value = std::max(factor * scene_length, at_least);
   return {key, *value, from_scene};
 }
 
@@ -91,7 +91,8 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
   const SceneLengths& marks = options->scene_lengths;
   defaults.lengths = {
       Choose("model.sigma_hat", factors.sigma_hat, s, &options->sigma_hat, marks.sigma_hat),
-      Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max),
+      Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
+             factors.k_max_of_diagonal * defaults.scale.diagonal),
       Choose("visibility.depth_tolerance", factors.depth_tolerance, s,
              &options->visibility.depth_tolerance, marks.depth_tolerance),
       Choose("solver.initial_step", factors.initial_step, s, &options->solver.initial_step,

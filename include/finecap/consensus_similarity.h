@@ -51,6 +51,9 @@ namespace finecap {
 
 class ConsensusSimilarity : public SimilarityTerm {
  public:
+  // Nodes of each colour table for Gaussians of `sigma_hat` over [-k_max, k_max].
+  static int NumTableNodes(double sigma_hat, double k_max);
+
   // `one_rings[s]` lists the surface Gaussians adjacent to s on the mesh (not s itself). `views`
   // must have been built without colour weights; `surface` and `views` must outlive this object.
   ConsensusSimilarity(const SurfaceGaussians& surface, const std::vector<EnergyView>& views,
@@ -102,7 +105,9 @@ class ConsensusSimilarity : public SimilarityTerm {
   // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
   double node_k0_ = 0.0, node_step_ = 1.0;
   int num_nodes_ = 0;
-  std::vector<std::vector<Eigen::Vector3d>> table_, table_derivative_;
+  // In single precision: the tables are the similarity's largest part (~24 bytes per node), and
+  // colours carry 8 bits.
+  std::vector<std::vector<Eigen::Vector3f>> table_, table_derivative_;
   Eigen::VectorXd shape_;
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].

@@ -26,7 +26,7 @@ struct ConsensusOptions {
   bool gain_per_channel = true;
   // Cauchy's robust loss on each patch's squared disagreement, with its scale this fraction of
   // the disagreement of unrelated patches; 0 turns it off (plain least squares).
-  double robust_fraction = 0.0;
+  double robust_fraction = 0.5;
 
   void Check() const;
 };
@@ -41,7 +41,7 @@ struct EnergyOptions {
   //  "consensus":     the cameras that see a patch of surface Gaussians must agree on its
   //                   normalised colours; no reference colours (consensus_similarity.h).
   // Default "surface_color" (measured with `finecap probe` and `finecap refine`, see the README).
-  std::string similarity = "surface_color";
+  std::string similarity = "consensus";
   // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
   // (the true integral, half the exponent). See gaussian_overlap.h.
   std::string overlap = "printed";
@@ -57,7 +57,7 @@ struct EnergyOptions {
   // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg, and its
   // E_sim). Default 1e-7, for the surface-colour similarity, whose residuals are colour
   // differences (~0.01) where the paper's E_sim counts image patches (~1e4).
-  double w_reg = 1e-7;
+  double w_reg = 1e-6;
   // Weight w_prior of a pull of every k_s towards 0 (the input surface), E_prior = sum (u k_s)^2,
   // E = E_sim - w_reg E_reg - w_prior E_prior. Where the images say nothing about k (a plain,
   // textureless cloth) it keeps the input; where they do, the data outweighs it. Not in the

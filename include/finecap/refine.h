@@ -32,7 +32,7 @@ namespace finecap {
 inline ImageGaussianOptions RefinementImageOptions() {
   ImageGaussianOptions options;
   options.min_leaf_size = 2;
-  options.color_space = ColorSpace::kChromaticity;
+  options.color_space = ColorSpace::kNormalizedRgb;
   return options;
 }
 

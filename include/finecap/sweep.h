@@ -16,7 +16,7 @@ namespace finecap {
 
 struct SweepOptions {
   // Number of displacements tried in [-k_max, k_max]; 0 turns the sweep off. Default 0.
-  int samples = 0;
+  int samples = 33;
   // Rounds of averaging each Gaussian's cost curve with its neighbours'. Default 4.
   int smoothing_rounds = 4;
 

@@ -23,7 +23,7 @@ struct VisibilityOptions {
   // projection far. Default 35: measured with `finecap probe`, both similarities peak closer to
   // the true surface with oblique views left out (skirt, 8 cameras: 0.77 at 75, 0.95 at 35), and
   // a ring of 8 cameras still sees every point within 35 degrees.
-  double max_view_angle_deg = 35.0;
+  double max_view_angle_deg = 60.0;
   // Points projecting closer than this to the image border are not used, pixels. Default 2.
   double border_margin = 2.0;
 
