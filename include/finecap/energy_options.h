@@ -40,7 +40,10 @@ struct EnergyOptions {
   //                   the README for why it peaks at the true surface where the paper's does not);
   //  "consensus":     the cameras that see a patch of surface Gaussians must agree on its
   //                   normalised colours; no reference colours (consensus_similarity.h).
-  // Default "surface_color" (measured with `finecap probe` and `finecap refine`, see the README).
+  // Default "consensus": on captures whose reference frame is as coarse as any other (every real
+  // one) it recovers detail where surface_color, whose reference colours then belong to the
+  // wrong surface points, does not (measured with `finecap probe` and `finecap refine`, see the
+  // README; configs/surface_color.yaml keeps surface_color's settings).
   std::string similarity = "consensus";
   // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
   // (the true integral, half the exponent). See gaussian_overlap.h.
@@ -55,8 +58,9 @@ struct EnergyOptions {
   // follow from the scene unless set (RefineOptions::scene_lengths).
   double k_max = 0.02;
   // Weight w_reg of the regulariser. Paper: 1 (with k in millimetres inside E_reg, and its
-  // E_sim). Default 1e-7, for the surface-colour similarity, whose residuals are colour
-  // differences (~0.01) where the paper's E_sim counts image patches (~1e4).
+  // E_sim). Default 1e-6, for the consensus similarity, whose residuals are contrast-weighted
+  // normalised patches (~0.01-0.1); surface_color was measured with 1e-7, and the paper's E_sim,
+  // which counts image patches (~1e4), with 1.
   double w_reg = 1e-6;
   // Weight w_prior of a pull of every k_s towards 0 (the input surface), E_prior = sum (u k_s)^2,
   // E = E_sim - w_reg E_reg - w_prior E_prior. Where the images say nothing about k (a plain,

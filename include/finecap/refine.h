@@ -86,13 +86,16 @@ struct RefineOptions {
   // Start each frame from the previous frame's k instead of from zero. Default false.
   bool warm_start = false;
 
-  // A plane-sweep search for each Gaussian's starting displacement (sweep.h); off by default.
+  // A plane-sweep search for each Gaussian's starting displacement (sweep.h).
   SweepOptions sweep;
   CoarseToFineOptions coarse_to_fine;
 
   // The image model. Defaults differ from ImageGaussianOptions' (the paper's) in two measured
-  // ways: leaves down to 2 px (sigma 1 px) keep the texture detail the colour residual needs,
-  // and colours are compared as chromaticity, which shading does not change.
+  // ways: leaves down to 2 px (sigma 1 px) keep the texture detail the similarity needs, and
+  // colours are normalized RGB, which keeps brightness: within one frame a matte surface's
+  // shading is the same in every camera, so the consensus similarity may compare it, and a grey
+  // object has texture only there (surface_color, which compares one frame with another, used
+  // chromaticity; configs/surface_color.yaml).
   ImageGaussianOptions image = RefinementImageOptions();
   VisibilityOptions visibility;
   EnergyOptions energy;

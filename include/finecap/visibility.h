@@ -20,9 +20,10 @@ struct VisibilityOptions {
   double depth_tolerance = 0.01;
   // Largest angle between the normal and the direction to the camera, degrees; beyond it the
   // point is back-facing or seen so obliquely that folds hide parts of it and a small k moves its
-  // projection far. Default 35: measured with `finecap probe`, both similarities peak closer to
-  // the true surface with oblique views left out (skirt, 8 cameras: 0.77 at 75, 0.95 at 35), and
-  // a ring of 8 cameras still sees every point within 35 degrees.
+  // projection far. Default 60, for the consensus similarity, which needs two cameras that see
+  // a patch: with a ring of 8 cameras 45 degrees apart, 35 degrees left 87 % of synth_skirt's
+  // Gaussians with fewer than two. surface_color, which needs one, peaks closer to the truth with
+  // 35 (skirt: 0.77 at 75, 0.95 at 35; configs/surface_color.yaml).
   double max_view_angle_deg = 60.0;
   // Points projecting closer than this to the image border are not used, pixels. Default 2.
   double border_margin = 2.0;
