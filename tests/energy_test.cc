@@ -88,27 +88,14 @@ TEST_P(EnergyDerivativeTest, ResidualJacobiansMatchCentralDifferences) {
   EXPECT_LE(disagreeing, similarity == "paper" ? 2 : 0);
 }
 
-// The least-squares residuals and the scalar similarity describe the same colour residual.
-TEST(SurfaceColorSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
-  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 3);
-  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
-                     Options("surface_color", "printed"));
-  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.005, 4);
-  SimilarityTerm& term = energy.similarity();
-  term.PrepareResiduals(k, false);
-  double sum = 0.0;
-  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
-    std::vector<double> residuals(term.residual_blocks()[b].num_residuals);
-    term.BlockResiduals(b, residuals.data(), nullptr);
-    for (double r : residuals) sum += r * r;
-  }
-  EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
-}
+// The least-squares residuals and the scalar similarity describe the same residual, for each
+// similarity whose scalar is a sum of squares.
+class ScalarAndResidualsTest : public ::testing::TestWithParam<std::string> {};
 
-TEST(ConsensusSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
+TEST_P(ScalarAndResidualsTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
-                     Options("consensus", "printed"));
+                     Options(GetParam(), "printed"));
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.005, 4);
   SimilarityTerm& term = energy.similarity();
   ASSERT_GT(term.residual_blocks().size(), 10u);
@@ -122,6 +109,9 @@ TEST(ConsensusSimilarityTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
   EXPECT_GT(sum, 0.0);
   EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
 }
+
+INSTANTIATE_TEST_SUITE_P(SumOfSquares, ScalarAndResidualsTest,
+                         ::testing::Values("surface_color", "consensus"));
 
 // A camera's gain and offset (per channel, as exposure and white balance) change each block's
 // weight but not the direction of its residual vector: the disagreement the solver sees is the

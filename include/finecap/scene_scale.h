@@ -51,13 +51,13 @@ constexpr double kFootprintsPerSceneLength = 3.0;
 
 // Each length that follows from the scene, as a multiple of the scene length s.
 struct SceneLengthFactors {
-  double sigma_hat = 0.6;        // 6.8 mm on synth_skirt (s = 11.4 mm), 0.71 mm on the temple.
+  double sigma_hat = 0.6;  // 6.8 mm on synth_skirt (s = 11.4 mm), 0.71 mm on the temple.
   // k_max is also at least this fraction of the mesh's bounding-box diagonal: how far a coarse
   // input lies from the truth depends on how it was made (a body model's fit, a template's
   // tracking, a visual hull, all off by a few per cent of the subject's size), not on how densely
   // it is meshed. 24 mm on synth_skirt (1.18 m across), 4.1 mm on the temple (0.2 m), whose
   // visual hull lies up to a centimetre outside its concavities.
-  double k_max = 1.75;           // 20 mm; 2.1 mm.
+  double k_max = 1.75;  // 20 mm; 2.1 mm.
   double k_max_of_diagonal = 0.02;
   double depth_tolerance = 0.9;  // 10 mm; 1.1 mm.
   double initial_step = 0.045;   // 0.51 mm; 0.054 mm.
