@@ -81,9 +81,9 @@ double PaperSimilarityAtResult(const SequenceModel& model, const ReferenceColors
   options.energy.similarity = "paper";
   const PreparedFrame frame = PrepareFrame(model, colors, input, options);
   const std::vector<int>& ids = frame.energy->surface().vertex_ids;
-  const double bias = options.bias_compensation && !stats.kept_input ? options.sigma_hat : 0.0;
+  const Eigen::VectorXd solved = SolvedDisplacement(k_fine, stats.kept_input, options);
   Eigen::VectorXd k(ids.size());
-  for (size_t s = 0; s < ids.size(); ++s) k[s] = k_fine[ids[s]] - bias;
+  for (size_t s = 0; s < ids.size(); ++s) k[s] = solved[ids[s]];
   double similarity = 0.0;
   frame.energy->Evaluate(k, nullptr, &similarity);
   return similarity;

@@ -9,6 +9,7 @@
 #include "commands/run_folder.h"
 #include "finecap/atomic_file.h"
 #include "finecap/commands.h"
+#include "finecap/comparison.h"
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
 #include "finecap/heldout_score.h"
@@ -46,9 +47,9 @@ Eigen::VectorXd WarmStart(const std::string& out, const Capture& capture, int fr
   const internal::FrameFiles previous =
       internal::FrameFilesIn(out, capture.frame_name(frame - 1), config.output.mesh_format);
   if (!internal::FrameDone(previous)) return {};
-  const double bias = config.refine.bias_compensation ? config.refine.sigma_hat : 0.0;
-  return internal::ReadDisplacement(previous.displacement, model.num_fine_vertices()).array() -
-         bias;
+  return SolvedDisplacement(
+      internal::ReadDisplacement(previous.displacement, model.num_fine_vertices()),
+      ReadFrameStats(previous.stats).kept_input, config.refine);
 }
 
 // The refined vertices outside and inside the capture's textureless region.
