@@ -10,8 +10,10 @@
 #include "finecap/commands.h"
 #include "finecap/comparison.h"
 #include "finecap/error.h"
+#include "finecap/frame_reader.h"
 #include "finecap/html_report.h"
 #include "finecap/plot.h"
+#include "finecap/run_folder.h"
 #include "finecap/solver_trace.h"
 #include "finecap/threads.h"
 #include "io_util.h"
@@ -37,24 +39,12 @@ std::vector<Variant> VariantConfigs(const Config& config) {
   return variants;
 }
 
-// Everything the reference colours depend on (ComputeSequenceColors, and the held-out cameras it
-// must not see): variants that agree on it share one computation.
-std::string ReferenceColorRecipe(const Config& config) {
-  const RefineOptions& refine = config.refine;
-  std::ostringstream recipe;
-  recipe.precision(17);
-  recipe << config.reference_frame << " " << refine.subdivision_levels << " " << refine.sigma_hat
-         << " " << refine.reference_colors << " " << ColorSpaceName(refine.image.color_space) << " "
-         << refine.image.max_depth << " " << refine.image.min_leaf_size << " "
-         << refine.image.split_threshold << " " << refine.visibility.depth_tolerance << " "
-         << refine.visibility.max_view_angle_deg << " " << refine.visibility.border_margin << " "
-         << refine.energy.overlap << " " << refine.energy.reach_sigmas;
-  for (const std::string& held_out : config.validation.cameras) recipe << "\n" << held_out;
-  return recipe.str();
+std::string ColorsPath(const Variant& variant) {
+  return ReferenceColorsPath(variant.config.output.dir);
 }
 
-std::string ColorsPath(const Variant& variant) {
-  return variant.config.output.dir + "/reference_colors.txt";
+std::string RecipeOf(const Variant& variant) {
+  return ReferenceColorRecipe(internal::SequenceOptionsOf(variant.config));
 }
 
 // Gives variants[index] the reference colours an earlier variant with the same recipe saved,
@@ -63,7 +53,7 @@ void ShareReferenceColors(const std::vector<Variant>& variants, size_t index) {
   const Variant& variant = variants[index];
   if (fs::exists(ColorsPath(variant))) return;
   for (size_t earlier = 0; earlier < index; ++earlier) {
-    if (ReferenceColorRecipe(variants[earlier].config) == ReferenceColorRecipe(variant.config) &&
+    if (RecipeOf(variants[earlier]) == RecipeOf(variant) &&
         fs::exists(ColorsPath(variants[earlier]))) {
       fs::create_directories(variant.config.output.dir);
       WriteTextFileAtomically(ColorsPath(variant),
@@ -100,12 +90,12 @@ VariantSummary MeasureVariant(const Variant& variant, const FrameRange& frames, 
   std::vector<FrameStats> records;
   std::vector<double> paper_similarity;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
-    const std::string& name = capture->frame_name(frame);
-    records.push_back(ReadFrameStats(out + "/frames/" + name + ".json"));
-    const Eigen::VectorXd k =
-        internal::ReadDisplacement(out + "/k/" + name + ".txt", model.num_fine_vertices());
-    FrameInput input = internal::ReadFrameInput(capture, frame);
-    internal::TakeHeldOutViews(config, &input);  // The energy as the variant's refine saw it.
+    const FrameFiles files =
+        FrameFilesIn(out, capture->frame_name(frame), internal::MeshFormatOf(config));
+    records.push_back(ReadFrameStats(files.stats));
+    const Eigen::VectorXd k = ReadDisplacement(files.displacement, model.num_fine_vertices());
+    FrameInput input = ReadFrameInput(capture, frame);
+    TakeHeldOutViews(config.validation.cameras, &input);  // The energy as its refine saw it.
     paper_similarity.push_back(
         PaperSimilarityAtResult(model, colors, input, config, records.back(), k));
   }
@@ -117,7 +107,9 @@ std::vector<std::string> WriteConvergencePlots(const std::vector<Variant>& varia
                                                const std::string& frame, const std::string& out) {
   std::vector<PlotSeries> by_iteration, by_time;
   for (const Variant& variant : variants) {
-    const std::string path = variant.config.output.dir + "/traces/" + frame + ".csv";
+    const std::string path =
+        FrameFilesIn(variant.config.output.dir, frame, internal::MeshFormatOf(variant.config))
+            .trace;
     if (!fs::exists(path)) continue;  // A frame refined before traces were saved.
     PlotSeries iterations{variant.spec.name, {}, {}}, times{variant.spec.name, {}, {}};
     for (const SolverIteration& row : ReadSolverTraceCsv(path)) {
@@ -186,7 +178,8 @@ int RunCompare(const Config& config) {
               << SettingsText(variants[i].spec) << "\n";
     ShareReferenceColors(variants, i);
     SetWorkerThreads(variants[i].config.runtime.threads);  // a variant may set runtime.threads
-    RunRefine(variants[i].config);
+    internal::RefineConfiguredSequence(variants[i].config, frames, variants[i].config.output.dir,
+                                       "compare, " + variants[i].spec.name, &capture);
     rows.push_back(MeasureVariant(variants[i], frames, &capture));
   }
   SetWorkerThreads(config.runtime.threads);

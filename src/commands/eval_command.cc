@@ -124,7 +124,7 @@ FlowSetup PrepareFlow(const Config& config, const SequenceModel& model, Capture*
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
           "frame " + std::to_string(config.reference_frame) + " does not exist in " +
               capture->directory());
-  const FrameInput reference = internal::ReadFrameInput(capture, config.reference_frame);
+  const FrameInput reference = ReadFrameInput(capture, config.reference_frame);
   const Mesh fine = model.Subdivide(reference.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
   setup.texture = MakeProjectiveTexture(
@@ -163,18 +163,17 @@ struct EvaluationRun {
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
 };
 
-void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
-                   const SequenceModel& model, const std::vector<int>& textureless,
-                   const FlowSetup* flow, const std::string& eval_dir, Capture* capture,
-                   EvaluationRun* run) {
+void EvaluateFrame(const RefinedFrame& frame, const Config& config, const SequenceModel& model,
+                   const std::vector<int>& textureless, const FlowSetup* flow,
+                   const std::string& eval_dir, Capture* capture, EvaluationRun* run) {
   const Mesh coarse = capture->ReadCoarseMesh(frame.index);
   const Mesh input = model.Subdivide(coarse);
-  const Mesh refined = ReadMesh(frame.mesh);
-  const Eigen::VectorXd k = internal::ReadDisplacement(frame.displacement, input.num_vertices());
-  Eigen::VectorXd k_true = internal::TrueFineDisplacement(*capture, model, coarse, frame.index);
+  const Mesh refined = ReadMesh(frame.files.mesh);
+  const Eigen::VectorXd k = ReadDisplacement(frame.files.displacement, input.num_vertices());
+  Eigen::VectorXd k_true = TrueFineDisplacement(*capture, model, coarse, frame.index);
   if (k_true.size() == 0) k_true = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
   const EvaluationSamples samples = MakeEvaluationSamples(
-      input, refined, k, k_true, model.refined_vertices(), textureless, frame.mesh);
+      input, refined, k, k_true, model.refined_vertices(), textureless, frame.files.mesh);
   const EvaluationFigures figures = ComputeEvaluationFigures(samples);
   run->names.push_back(frame.name);
   run->frame_indices.push_back(frame.index);
@@ -186,9 +185,9 @@ void EvaluateFrame(const internal::RefinedFrame& frame, const Config& config,
                             : FlowComparison());
   run->pooled_flow.Add(run->flows.back());
   if (!config.validation.cameras.empty()) {
-    run->heldout.push_back(internal::EvaluateHeldOutFrame(
-        config, frame.name, internal::ReadFrameInput(capture, frame.index), input, refined,
-        eval_dir, &run->pictures));
+    run->heldout.push_back(
+        internal::EvaluateHeldOutFrame(config, frame.name, ReadFrameInput(capture, frame.index),
+                                       input, refined, eval_dir, &run->pictures));
   }
   const Camera& camera = capture->cameras()[config.eval.camera];
   const cv::Mat image = capture->ReadImage(config.eval.camera, frame.index);
@@ -385,8 +384,8 @@ constexpr int kViewerFrames = 5;
 // The report's 3D view: the input and refined meshes of up to kViewerFrames frames, evenly spaced
 // over the evaluated ones, seen first from the eval camera. Where three.js is absent a note takes
 // its place and a warning goes to stderr: the report is still written.
-std::string ViewerHtml(const std::vector<internal::RefinedFrame>& frames,
-                       const SequenceModel& model, const Camera& camera, Capture* capture) {
+std::string ViewerHtml(const std::vector<RefinedFrame>& frames, const SequenceModel& model,
+                       const Camera& camera, Capture* capture) {
   const std::optional<ThreeJsLibrary> library = FindThreeJs();
   if (!library) {
     std::cerr << "finecap eval: warning: three.js not found (install Debian's libjs-three or set "
@@ -395,9 +394,9 @@ std::string ViewerHtml(const std::vector<internal::RefinedFrame>& frames,
   }
   std::vector<ViewerFrame> shown;
   for (int i : EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames)) {
-    const internal::RefinedFrame& frame = frames[i];
-    shown.push_back(
-        {frame.name, model.Subdivide(capture->ReadCoarseMesh(frame.index)), ReadMesh(frame.mesh)});
+    const RefinedFrame& frame = frames[i];
+    shown.push_back({frame.name, model.Subdivide(capture->ReadCoarseMesh(frame.index)),
+                     ReadMesh(frame.files.mesh)});
   }
   return MeshViewerHtml(shown, camera, *library);
 }
@@ -455,9 +454,8 @@ int RunEval(const Config& configured) {
   Require(config.eval.camera < capture.num_cameras(), "eval.camera",
           std::to_string(config.eval.camera) + " is not a camera of " + capture.directory() +
               ", which has " + std::to_string(capture.num_cameras()));
-  const std::vector<internal::RefinedFrame> frames =
-      internal::FindRefinedFrames(config, capture, out);
-  const std::string eval_dir = out + "/eval";
+  const std::vector<RefinedFrame> frames = internal::FindRefinedFrames(config, capture, out);
+  const std::string eval_dir = EvalFolder(out);
   fs::create_directories(eval_dir);
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
@@ -467,7 +465,7 @@ int RunEval(const Config& configured) {
   if (config.eval.flow != "none") flow = PrepareFlow(config, model, &capture);
   EvaluationRun run;
   internal::Progress progress(frames.size());
-  for (const internal::RefinedFrame& frame : frames) {
+  for (const RefinedFrame& frame : frames) {
     EvaluateFrame(frame, config, model, textureless, flow ? &*flow : nullptr, eval_dir, &capture,
                   &run);
     progress.FrameDone(frame.name, false, "");

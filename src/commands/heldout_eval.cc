@@ -76,7 +76,7 @@ HeldOutFrame EvaluateHeldOutFrame(const Config& config, const std::string& frame
                                   FrameInput frame, const Mesh& input, const Mesh& refined,
                                   const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures) {
-  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config, &frame);
+  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config.validation.cameras, &frame);
   std::vector<HeldOutViewMaps> maps;
   HeldOutFrame result{frame_name,
                       ScoreHeldOutViews(CalibratedImagesOf(frame), held_out, {&input, &refined},
