@@ -15,7 +15,6 @@
 #include "finecap/error.h"
 #include "finecap/frame_stats.h"
 #include "finecap/synth.h"
-#include "finecap/threads.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 
@@ -26,16 +25,11 @@ namespace fs = std::filesystem;
 using testing_util::ExpectErrorMentions;
 using testing_util::FileBytes;
 using testing_util::MakeTempDir;
+using testing_util::OneWorkerThread;
 
 FrameStats Record(const std::string& out, const std::string& frame) {
-  return ParseFrameStats(FileBytes(out + "/frames/" + frame + ".json"), out);
+  return ReadFrameStats(FrameFilesIn(out, frame, MeshFormat::kPly).stats);
 }
-
-// One OpenMP thread while in scope: two runs then evaluate the energy to the same bits.
-struct OneWorkerThread {
-  OneWorkerThread() { SetWorkerThreads(1); }
-  ~OneWorkerThread() { SetWorkerThreads(0); }
-};
 
 // A frame whose input was kept has, as solved, displacement 0: the frame after it starts there,
 // as a frame without a predecessor does, and not at -sigma_hat (its saved 0 with the bias
