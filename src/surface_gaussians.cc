@@ -9,27 +9,10 @@
 #include "finecap/error.h"
 #include "finecap/surface_color_similarity.h"
 #include "finecap/surface_projection.h"
+#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {
-
-// The camera whose viewing direction (from the vertex towards the camera) aligns best with the
-// normal, among those that see the vertex; -1 when none does.
-int BestAlignedCamera(const Eigen::Vector3d& vertex, const Eigen::Vector3d& normal,
-                      const std::vector<Camera>& cameras,
-                      const std::vector<std::vector<unsigned char>>& visible, int v) {
-  int best = -1;
-  double best_alignment = -2.0;
-  for (size_t c = 0; c < cameras.size(); ++c) {
-    if (!visible[c][v]) continue;
-    const double alignment = normal.dot((cameras[c].Center() - vertex).normalized());
-    if (alignment > best_alignment) {
-      best_alignment = alignment;
-      best = static_cast<int>(c);
-    }
-  }
-  return best;
-}
 
 // Mean of the pixels of `image` (CV_32FC3) under a Gaussian of standard deviation `sigma` pixels
 // centred at `mean`, weighted by the Gaussian, out to two standard deviations.
@@ -74,7 +57,8 @@ ReferenceColors ColorFromBestCameras(const Eigen::Matrix3Xd& vertices,
   result.valid.assign(n, 0);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int v = 0; v < n; ++v) {
-    const int c = BestAlignedCamera(vertices.col(v), normals.col(v), cameras, visible, v);
+    const int c = MostFrontalCamera(vertices.col(v), normals.col(v), cameras,
+                                    [&](int camera) { return visible[camera][v] != 0; });
     if (c < 0) continue;
     const ProjectedGaussian projected =
         ProjectSurfaceGaussian(cameras[c], vertices.col(v), normals.col(v), 0.0, sigma_hat);
