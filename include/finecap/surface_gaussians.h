@@ -33,8 +33,11 @@ struct SurfaceGaussians {
 // says whether any camera saw it. Saved once per sequence so that any frame can run on its own.
 struct ReferenceColors {
   ColorSpace color_space = ColorSpace::kHsv;
-  double sigma_hat = 0.007;             // The footprint they were averaged over, metres.
-  std::string method = "pixels";        // How they were taken: "pixels" or "image_model".
+  double sigma_hat = 0.007;       // The footprint they were averaged over, metres.
+  std::string method = "pixels";  // How they were taken: "pixels" or "image_model".
+  // What they were computed from, one line (ReferenceColorRecipe, sequence.h); saved in the file
+  // so that a run reusing it can check it. Empty in files saved before recipes were.
+  std::string recipe;
   std::vector<Eigen::Vector3f> colors;  // One per mesh vertex.
   std::vector<unsigned char> valid;     // 1 where a camera saw the vertex.
 };
