@@ -63,7 +63,7 @@ const SkirtFrame& Skirt() {
 
 RefineOptions Options(const std::string& similarity) {
   RefineOptions options;
-  options.energy.similarity = similarity;
+  StringToEnum(similarity, &options.energy.similarity);
   return options;
 }
 

@@ -138,7 +138,7 @@ double BoundingBoxDiagonal(const Mesh& mesh) {
 void RequirePlausibleSceneScale(const Mesh& mesh, double sigma_hat, const std::string& where,
                                 const SceneScaleLimits& limits) {
   limits.Check();
-  Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
+  Require(sigma_hat > 0.0, "sigma_hat", "must be positive");
   const double diagonal = BoundingBoxDiagonal(mesh);
   const double sigmas = diagonal / sigma_hat;
   if (sigmas >= limits.min_sigmas && sigmas <= limits.max_sigmas) return;

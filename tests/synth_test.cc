@@ -220,7 +220,8 @@ TEST(SynthTest, BadSmoothingStrengthIsRefusedNamingTheKey) {
     GenerateSyntheticCapture(options, out);
     FAIL() << "no error";
   } catch (const Error& error) {
-    EXPECT_NE(std::string(error.what()).find("synth.smoothing.iterations"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("SynthOptions::smoothing.iterations"),
+              std::string::npos)
         << error.what();
   }
   EXPECT_FALSE(fs::exists(out));
@@ -408,7 +409,8 @@ TEST(SynthTest, InvalidOptionsNameTheField) {
     options.Check();
     FAIL() << "no error";
   } catch (const Error& error) {
-    EXPECT_NE(std::string(error.what()).find("synth.folds[1].wavelength"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("SynthOptions::folds[1].wavelength"),
+              std::string::npos);
   }
   options = TinyOptions();
   options.subject = "mesh";

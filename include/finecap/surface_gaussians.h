@@ -12,6 +12,7 @@
 
 #include "finecap/camera.h"
 #include "finecap/color.h"
+#include "finecap/enum_names.h"
 #include "finecap/gaussian_overlap.h"
 #include "finecap/image_gaussians.h"
 
@@ -29,14 +30,19 @@ struct SurfaceGaussians {
   int size() const { return static_cast<int>(vertex_ids.size()); }
 };
 
+// How the reference frame colours the surface Gaussians: the mean of the pixels under each
+// projected Gaussian (the paper), or what the image model shows there.
+enum class ReferenceColorSource { kPixels, kImageModel };
+const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSource);
+
 // Colours of the vertices of a mesh, taken from one frame's images, with a flag per vertex that
 // says whether any camera saw it. Saved once per sequence so that any frame can run on its own.
 struct ReferenceColors {
   ColorSpace color_space = ColorSpace::kHsv;
-  double sigma_hat = 0.007;             // The footprint they were averaged over, metres.
-  std::string method = "pixels";        // How they were taken: "pixels" or "image_model".
-  std::vector<Eigen::Vector3f> colors;  // One per mesh vertex.
-  std::vector<unsigned char> valid;     // 1 where a camera saw the vertex.
+  double sigma_hat = 0.007;  // The footprint they were averaged over, metres.
+  ReferenceColorSource method = ReferenceColorSource::kPixels;  // How they were taken.
+  std::vector<Eigen::Vector3f> colors;                          // One per mesh vertex.
+  std::vector<unsigned char> valid;                             // 1 where a camera saw the vertex.
 };
 
 // The paper's colouring: for each vertex, the camera that sees it best (visible, and whose

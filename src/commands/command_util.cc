@@ -191,10 +191,10 @@ ReferenceColors LoadOrComputeReferenceColors(const Config& config, const Sequenc
                 saved.method == options.reference_colors,
             path,
             "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +
-                std::to_string(saved.sigma_hat) + " and method " + saved.method +
+                std::to_string(saved.sigma_hat) + " and method " + EnumToString(saved.method) +
                 ", but the config asks for " + ColorSpaceName(options.image.color_space) + ", " +
-                std::to_string(options.sigma_hat) + " and " + options.reference_colors +
-                ": use another output folder");
+                std::to_string(options.sigma_hat) + " and " +
+                EnumToString(options.reference_colors) + ": use another output folder");
     return saved;
   }
   Require(config.reference_frame < capture->num_frames(), "model.reference_frame",

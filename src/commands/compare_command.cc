@@ -44,11 +44,12 @@ std::string ReferenceColorRecipe(const Config& config) {
   std::ostringstream recipe;
   recipe.precision(17);
   recipe << config.reference_frame << " " << refine.subdivision_levels << " " << refine.sigma_hat
-         << " " << refine.reference_colors << " " << ColorSpaceName(refine.image.color_space) << " "
-         << refine.image.max_depth << " " << refine.image.min_leaf_size << " "
-         << refine.image.split_threshold << " " << refine.visibility.depth_tolerance << " "
-         << refine.visibility.max_view_angle_deg << " " << refine.visibility.border_margin << " "
-         << refine.energy.overlap << " " << refine.energy.reach_sigmas;
+         << " " << EnumToString(refine.reference_colors) << " "
+         << ColorSpaceName(refine.image.color_space) << " " << refine.image.max_depth << " "
+         << refine.image.min_leaf_size << " " << refine.image.split_threshold << " "
+         << refine.visibility.depth_tolerance << " " << refine.visibility.max_view_angle_deg << " "
+         << refine.visibility.border_margin << " " << EnumToString(refine.energy.overlap) << " "
+         << refine.energy.reach_sigmas;
   for (const std::string& held_out : config.validation.cameras) recipe << "\n" << held_out;
   return recipe.str();
 }
@@ -78,7 +79,7 @@ double PaperSimilarityAtResult(const SequenceModel& model, const ReferenceColors
                                const FrameInput& input, const Config& config,
                                const FrameStats& stats, const Eigen::VectorXd& k_fine) {
   RefineOptions options = config.refine;
-  options.energy.similarity = "paper";
+  options.energy.similarity = SimilarityType::kPaper;
   const PreparedFrame frame = PrepareFrame(model, colors, input, options);
   const std::vector<int>& ids = frame.energy->surface().vertex_ids;
   const double bias = options.bias_compensation && !stats.kept_input ? options.sigma_hat : 0.0;
