@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/error.h"
+#include "finecap/optical_flow.h"
 #include "finecap/scene_scale.h"
 
 namespace finecap {
@@ -72,6 +73,13 @@ void AddValidationKeys(ValidationConfig* validation, ConfigSchema* schema) {
                     0.01, 1000.0);
 }
 
+// eval.flow: a method of the optical flow, or none.
+std::vector<std::string> FlowChoices() {
+  std::vector<std::string> choices = EnumNameList<FlowMethod>();
+  choices.push_back("none");
+  return choices;
+}
+
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.dir", &config->capture.dir,
                     "Capture folder (cameras, images or videos, meshes; see the README).");
@@ -100,10 +108,9 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddChoice("eval.flow", &config->eval.flow,
                     "finecap eval: optical flow between the textured model's render and the "
                     "image (the paper's section 7): dis, deepflow (slower) or none.",
-                    {"dis", "deepflow", "none"});
+                    FlowChoices());
   schema->AddChoice("eval.flow_dis_preset", &config->eval.flow_dis_preset,
-                    "finecap eval: preset of the DIS optical flow.",
-                    {"ultrafast", "fast", "medium"});
+                    "finecap eval: preset of the DIS optical flow.", EnumNameList<DisPreset>());
   schema->AddChoice("eval.flow_cameras", &config->eval.flow_cameras,
                     "finecap eval: cameras the flow is measured in, pixels pooled: all, or "
                     "eval_camera (eval.camera only, as the paper's Figure 6).",

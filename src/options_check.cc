@@ -1,5 +1,6 @@
 // The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h)
-// and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h):
+// and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
+// of the optical flow's (optical_flow.h), which the config's eval section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
 //
@@ -9,6 +10,7 @@
 #include "finecap/error.h"
 #include "finecap/gaussian_overlap.h"
 #include "finecap/heldout_score.h"
+#include "finecap/optical_flow.h"
 #include "finecap/refine.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
@@ -53,6 +55,19 @@ const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType) {
       {LinearSolverType::kSparseNormalCholesky, "sparse_normal_cholesky"},
       {LinearSolverType::kCgnr, "cgnr"},
       {LinearSolverType::kDenseQr, "dense_qr"}};
+  return names;
+}
+
+const std::vector<EnumName<FlowMethod>>& EnumNames(FlowMethod) {
+  static const std::vector<EnumName<FlowMethod>> names = {{FlowMethod::kDis, "dis"},
+                                                          {FlowMethod::kDeepFlow, "deepflow"}};
+  return names;
+}
+
+const std::vector<EnumName<DisPreset>>& EnumNames(DisPreset) {
+  static const std::vector<EnumName<DisPreset>> names = {{DisPreset::kUltrafast, "ultrafast"},
+                                                         {DisPreset::kFast, "fast"},
+                                                         {DisPreset::kMedium, "medium"}};
   return names;
 }
 

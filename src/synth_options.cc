@@ -19,6 +19,33 @@ bool IsPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 }  // namespace
 
+const std::vector<EnumName<FoldProfile>>& EnumNames(FoldProfile) {
+  static const std::vector<EnumName<FoldProfile>> names = {{FoldProfile::kSine, "sine"},
+                                                           {FoldProfile::kRidge, "ridge"}};
+  return names;
+}
+
+const std::vector<EnumName<TexturePattern>>& EnumNames(TexturePattern) {
+  static const std::vector<EnumName<TexturePattern>> names = {{TexturePattern::kMixed, "mixed"},
+                                                              {TexturePattern::kPlaid, "plaid"},
+                                                              {TexturePattern::kStripes, "stripes"},
+                                                              {TexturePattern::kPrint, "print"},
+                                                              {TexturePattern::kNoise, "noise"}};
+  return names;
+}
+
+const std::vector<EnumName<SynthSubject>>& EnumNames(SynthSubject) {
+  static const std::vector<EnumName<SynthSubject>> names = {{SynthSubject::kSkirt, "skirt"},
+                                                            {SynthSubject::kMesh, "mesh"}};
+  return names;
+}
+
+const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput) {
+  static const std::vector<EnumName<CoarseInput>> names = {{CoarseInput::kUnfolded, "unfolded"},
+                                                           {CoarseInput::kSmoothed, "smoothed"}};
+  return names;
+}
+
 void TaubinSmoothingOptions::Check(const std::string& where) const {
   Require(iterations >= 1 && iterations <= 100000, where + ".iterations",
           "is " + std::to_string(iterations) + " but must lie in [1, 100000]");
@@ -40,8 +67,7 @@ void FoldComponent::Check(const std::string& where) const {
   RequireFieldFinite(orientation, where + ".orientation");
   RequireFieldFinite(phase, where + ".phase");
   RequireFieldFinite(drift, where + ".drift");
-  Require(profile == "sine" || profile == "ridge", where + ".profile",
-          "is '" + profile + "' but must be 'sine' or 'ridge'");
+  internal::RequireKnownChoice(profile, where + ".profile");
 }
 
 void SkirtOptions::Check() const {
@@ -63,10 +89,7 @@ void TextureOptions::Check() const {
   const std::string where = "TextureOptions::";
   Require(width >= 16 && width <= 16384, where + "width", "must lie in [16, 16384]");
   Require(height >= 16 && height <= 16384, where + "height", "must lie in [16, 16384]");
-  Require(pattern == "mixed" || pattern == "plaid" || pattern == "stripes" || pattern == "print" ||
-              pattern == "noise",
-          where + "pattern",
-          "is '" + pattern + "' but must be one of mixed, plaid, stripes, print, noise");
+  internal::RequireKnownChoice(pattern, where + "pattern");
   RequireFieldRange(textureless_begin, 0.0, 1.0, where + "textureless_begin");
   RequireFieldRange(textureless_end, textureless_begin, 1.0, where + "textureless_end");
   Require(textureless_color.allFinite() && textureless_color.minCoeff() >= 0.0 &&
@@ -102,10 +125,10 @@ RenderOptions SynthOptions::DefaultRenderOptions() {
 
 void SynthOptions::Check() const {
   const std::string where = "SynthOptions::";
-  Require(subject == "skirt" || subject == "mesh", where + "subject",
-          "is '" + subject + "' but must be 'skirt' or 'mesh'");
-  if (subject == "skirt") skirt.Check();
-  if (subject == "mesh") {
+  internal::RequireKnownChoice(subject, where + "subject");
+  internal::RequireKnownChoice(coarse, where + "coarse");
+  if (subject == SynthSubject::kSkirt) skirt.Check();
+  if (subject == SynthSubject::kMesh) {
     Require(!mesh_path.empty(), where + "mesh_path", "must name a mesh file or folder");
     Require(IsPowerOfTwo(truth_refinement), where + "truth_refinement",
             "must be a power of two for a mesh subject (midpoint subdivision levels)");

@@ -329,7 +329,8 @@ TEST(SynthTest, DistortedImagesUndistortBackToThePinholeRender) {
   options.cameras.focal = 140.0;
   options.cameras.distance = 1.0;  // Close, so that the skirt reaches where distortion is strong.
   options.render.supersampling = 2;
-  options.texture.pattern = "noise";  // Smooth, so that resampling twice blurs little.
+  options.texture.pattern =
+      TexturePattern::kNoise;  // Smooth, so that resampling twice blurs little.
   const SyntheticCapture pinhole(options);
   options.cameras.distortion = {-0.35, 0.1, 0.001, -0.002, 0.0};
   const SyntheticCapture distorted(options);
@@ -362,7 +363,7 @@ TEST(SynthTest, UserMeshGetsSubdividedAndFolded) {
   WriteMesh(folder + "/b.ply", source.Frame(1).coarse);
 
   SynthOptions options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.mesh_path = folder;
   options.truth_refinement = 2;
   const SyntheticCapture capture(options);
@@ -390,7 +391,7 @@ TEST(SynthTest, UserMeshFolderWithChangingTopologyIsRefused) {
   std::swap(second.faces(1, 0), second.faces(2, 0));
   WriteMesh(folder + "/001.ply", second);
   SynthOptions options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.mesh_path = folder;
   options.truth_refinement = 2;
   const SyntheticCapture capture(options);
@@ -413,7 +414,7 @@ TEST(SynthTest, InvalidOptionsNameTheField) {
               std::string::npos);
   }
   options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.truth_refinement = 3;
   options.mesh_path = "x.ply";
   EXPECT_THROW(options.Check(), Error);

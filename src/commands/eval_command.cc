@@ -116,8 +116,9 @@ struct FlowSetup {
 // flow_evaluation.h for why not the saved reference colours), over the faces of refined vertices.
 FlowSetup PrepareFlow(const Config& config, const SequenceModel& model, Capture* capture) {
   FlowSetup setup;
-  setup.options.method = config.eval.flow;
-  setup.options.dis_preset = config.eval.flow_dis_preset;
+  // The schema allows only the tables' names (and "none", which never gets here).
+  StringToEnum(config.eval.flow, &setup.options.method);
+  StringToEnum(config.eval.flow_dis_preset, &setup.options.dis_preset);
   for (int c = 0; c < capture->num_cameras(); ++c) {
     if (config.eval.flow_cameras == "all" || c == config.eval.camera) setup.cameras.push_back(c);
   }
