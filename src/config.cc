@@ -18,6 +18,15 @@ std::string AutoText(double factor) {
   return text.str();
 }
 
+// sigma_hat's factor depends on the similarity (scene_scale.h says why).
+std::string SigmaHatAutoText() {
+  std::ostringstream text;
+  text << AutoText(SceneLengthFactors().sigma_hat)
+       << " Under surface_color and paper: " << SceneLengthFactors().single_gaussian_sigma_hat
+       << " scene lengths.";
+  return text.str();
+}
+
 std::string NameListText(const std::vector<std::string>& names) {
   std::string text = "[";
   for (size_t i = 0; i < names.size(); ++i) text += (i ? ", " : "") + names[i];
@@ -126,10 +135,10 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                  0);
   schema->AddInt("model.subdivision_levels", &refine.subdivision_levels,
                  "Loop subdivision levels applied to the coarse mesh before refinement.", 0, 4);
-  schema->AddDoubleOrAuto("model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
-                          "Standard deviation of every surface Gaussian, metres (paper: 0.007); " +
-                              AutoText(SceneLengthFactors().sigma_hat),
-                          1e-5, 1.0);
+  schema->AddDoubleOrAuto(
+      "model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
+      "Standard deviation of every surface Gaussian, metres (paper: 0.007); " + SigmaHatAutoText(),
+      1e-5, 1.0);
   schema->AddEnum("model.reference_colors", &refine.reference_colors,
                   "How the reference frame colours the surface Gaussians: pixels (the paper) or "
                   "image_model (what the energy's image model shows in the best camera).");

@@ -90,7 +90,11 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
   const SceneLengthFactors factors;
   const SceneLengths& marks = options->scene_lengths;
   defaults.lengths = {
-      Choose("model.sigma_hat", factors.sigma_hat, s, &options->sigma_hat, marks.sigma_hat),
+      Choose("model.sigma_hat",
+             options->energy.similarity == SimilarityType::kConsensus
+                 ? factors.sigma_hat
+                 : factors.single_gaussian_sigma_hat,
+             s, &options->sigma_hat, marks.sigma_hat),
       Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
              factors.k_max_of_diagonal * defaults.scale.diagonal),
       Choose("visibility.depth_tolerance", factors.depth_tolerance, s,

@@ -53,6 +53,24 @@ TEST(SceneScale, MeasuresEdgeLengthAndPixelFootprint) {
   EXPECT_DOUBLE_EQ(unseen.length, unseen.mean_edge_length);
 }
 
+// The similarities that compare single Gaussians blur more than consensus, which compares patches.
+TEST(SceneScale, SigmaHatFollowsTheSimilarity) {
+  const Mesh grid = CentredGrid(0.01);
+  const Camera camera = LookAtOrigin(2.0, 0.0, 1000.0, 400);
+  const double s = GridMeanEdge(0.01);
+  const SceneLengthFactors factors;
+  for (const std::string similarity : {"consensus", "surface_color", "paper"}) {
+    RefineOptions options;
+    options.subdivision_levels = 0;
+    ASSERT_TRUE(StringToEnum(similarity, &options.energy.similarity)) << similarity;
+    ResolveSceneScaleDefaults(grid, {camera}, "grid.ply", &options);
+    const double factor =
+        similarity == "consensus" ? factors.sigma_hat : factors.single_gaussian_sigma_hat;
+    EXPECT_NEAR(options.sigma_hat, factor * s, 1e-12) << similarity;
+  }
+  EXPECT_LT(factors.sigma_hat, factors.single_gaussian_sigma_hat);
+}
+
 TEST(SceneScale, LengthsFollowTheSceneUnlessSet) {
   RefineOptions options;
   options.subdivision_levels = 0;
@@ -133,8 +151,9 @@ TEST(SceneScale, ASmallRealObjectGetsProportionateLengths) {
   EXPECT_GT(options.sigma_hat, 0.0004);
   EXPECT_LT(options.sigma_hat, 0.0012);
   EXPECT_LT(options.energy.k_max, 0.006);  // 2 % of its diagonal, against 24 mm for a person.
-  // A surface Gaussian still covers about 2 pixels.
-  EXPECT_GT(options.sigma_hat / defaults.scale.pixel_footprint, 1.5);
+  // A surface Gaussian is still wider than the finest image Gaussians (sigma 1 pixel, half of
+  // the 2-pixel leaves), so that the image model resolves it.
+  EXPECT_GT(options.sigma_hat / defaults.scale.pixel_footprint, 1.25);
 }
 
 }  // namespace

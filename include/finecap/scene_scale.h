@@ -10,9 +10,11 @@
 // the pixel footprint being the median, over the cameras and the fine vertices each sees in its
 // image, of depth / focal length (the metres one pixel covers at the surface). The edge length
 // says how densely surface Gaussians sample the surface; the footprint floor keeps a Gaussian
-// wide enough (about 2 pixels) for the image model to see. Each length is a fixed multiple of s
-// (SceneLengthFactors), chosen so that the person-sized presets keep the values finecap used
-// before it measured the scene (sigma_hat 7 mm, k_max 2 cm: synth_skirt's s is 11.4 mm).
+// wide enough (at least 1.3 pixels, wider than the finest image Gaussians) for the image model
+// to see. Each length is a fixed multiple of s (SceneLengthFactors), chosen so that the
+// person-sized presets keep the values finecap used before it measured the scene (k_max 2 cm:
+// synth_skirt's s is 11.4 mm; sigma_hat 7 mm under the similarities that compare single
+// Gaussians, 5 mm under consensus, which compares patches).
 //
 // Also a guard against captures in the wrong unit. finecap's lengths are metres (its outputs,
 // the synthetic folds), so a capture in millimetres or centimetres would not fail anywhere: with
@@ -51,7 +53,14 @@ constexpr double kFootprintsPerSceneLength = 3.0;
 
 // Each length that follows from the scene, as a multiple of the scene length s.
 struct SceneLengthFactors {
-  double sigma_hat = 0.6;  // 6.8 mm on synth_skirt (s = 11.4 mm), 0.71 mm on the temple.
+  // sigma_hat under the consensus similarity: 5.0 mm on synth_skirt (s = 11.4 mm), 0.52 mm on
+  // the temple. Its residuals compare patches (a Gaussian with its one-ring), which already
+  // average over a window, so each Gaussian needs less blur than one compared alone. 0.6 of s
+  // recovered 2 to 6 points less detail on synth_skirt, its ramped variant and the single 5 and
+  // 10 cm folds, and as much on synth_noisy and (held-out NCC) the temple.
+  double sigma_hat = 0.44;
+  // sigma_hat under surface_color and paper, which compare single Gaussians: 6.8 mm, 0.71 mm.
+  double single_gaussian_sigma_hat = 0.6;
   // k_max is also at least this fraction of the mesh's bounding-box diagonal: how far a coarse
   // input lies from the truth depends on how it was made (a body model's fit, a template's
   // tracking, a visual hull, all off by a few per cent of the subject's size), not on how densely
