@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -179,6 +180,9 @@ TEST(ConfigOptionsTest, EnumNamesRoundTripAndRefuseOthers) {
   TrustRegionType trust_region = TrustRegionType::kDogleg;
   EXPECT_FALSE(StringToEnum("Dogleg", &trust_region));
   EXPECT_EQ(trust_region, TrustRegionType::kDogleg);
+  std::ostringstream text;
+  text << OverlapForm::kExact << " " << LinearSolverType::kDenseQr;
+  EXPECT_EQ(text.str(), "exact dense_qr");
   EXPECT_FALSE(IsKnownEnum(static_cast<ReferenceColorSource>(9)));
   EXPECT_EQ(EnumToString(static_cast<ReferenceColorSource>(9)), "unknown");
 }

@@ -12,6 +12,7 @@
 #ifndef FINECAP_ENUM_NAMES_H_
 #define FINECAP_ENUM_NAMES_H_
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,13 @@ std::vector<std::string> EnumNameList() {
   std::vector<std::string> names;
   for (const EnumName<Enum>& entry : EnumNames(Enum{})) names.push_back(entry.name);
   return names;
+}
+
+// Writes the name of `value`, so that a writer of stats or a cache key prints a choice as the
+// config spells it.
+template <typename Enum, typename = decltype(EnumNames(Enum{}))>
+std::ostream& operator<<(std::ostream& out, Enum value) {
+  return out << EnumToString(value);
 }
 
 // The names joined by ", ", for messages.
