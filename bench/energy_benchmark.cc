@@ -17,6 +17,7 @@
 
 #include "finecap/capture.h"
 #include "finecap/config.h"
+#include "finecap/frame_reader.h"
 #include "finecap/refine.h"
 
 namespace finecap {
@@ -28,15 +29,6 @@ struct SkirtFrame {
   ReferenceColors colors;
   FrameInput input;
 };
-
-FrameInput ReadFrame(Capture* capture, int frame) {
-  FrameInput input;
-  input.coarse = capture->ReadCoarseMesh(frame);
-  input.cameras = capture->cameras();
-  for (int c = 0; c < capture->num_cameras(); ++c)
-    input.images.push_back(capture->ReadImage(c, frame));
-  return input;
-}
 
 // Frame 3 of synth_skirt (its folds fully grown), colours from frame 0.
 const SkirtFrame& Skirt() {
@@ -52,8 +44,9 @@ const SkirtFrame& Skirt() {
     skirt->dir = dir;
     skirt->model = std::make_unique<SequenceModel>(capture.ReadCoarseMesh(0), capture.vertex_mask(),
                                                    config.refine, dir);
-    skirt->colors = ComputeSequenceColors(*skirt->model, ReadFrame(&capture, 0), config.refine);
-    skirt->input = ReadFrame(&capture, 3);
+    skirt->colors =
+        ComputeSequenceColors(*skirt->model, ReadFrameInput(&capture, 0), config.refine);
+    skirt->input = ReadFrameInput(&capture, 3);
     static const std::string removed_at_exit = dir;
     std::atexit([] { std::filesystem::remove_all(removed_at_exit); });
     return skirt;
@@ -104,7 +97,7 @@ BENCHMARK(BM_PrepareFrame)->Unit(benchmark::kMillisecond);
 void BM_ReadFrame(benchmark::State& state) {
   Capture capture = Capture::Open(Skirt().dir);
   for (auto _ : state) {
-    FrameInput input = ReadFrame(&capture, 3);
+    FrameInput input = ReadFrameInput(&capture, 3);
     benchmark::DoNotOptimize(input.images.data());
   }
   state.counters["cameras"] = capture.num_cameras();

@@ -73,14 +73,6 @@ double Value(const NumberColumn& column, const VariantSummary& row) {
 
 }  // namespace
 
-FrameStats ReadFrameStats(const std::string& path) {
-  std::ifstream file(path);
-  Require(file.good(), path, "cannot open the statistics record");
-  std::string line;
-  std::getline(file, line);
-  return ParseFrameStats(line, path);
-}
-
 VariantSummary SummarizeVariant(const std::string& name, const std::vector<FrameStats>& frames,
                                 const std::vector<double>& paper_similarity) {
   Require(!frames.empty(), name, "no refined frame to summarise");

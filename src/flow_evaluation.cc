@@ -6,6 +6,7 @@
 
 #include "finecap/error.h"
 #include "finecap/render.h"
+#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {
@@ -23,17 +24,9 @@ int BestCameraOfFace(const Mesh& mesh, const Eigen::Matrix3Xd& normals, int face
     centre += mesh.vertices.col(corners[i]) / 3.0;
     normal += normals.col(corners[i]);
   }
-  int best = -1;
-  double best_alignment = -std::numeric_limits<double>::infinity();
-  for (size_t c = 0; c < cameras.size(); ++c) {
-    if (!visible[c][corners[0]] || !visible[c][corners[1]] || !visible[c][corners[2]]) continue;
-    const double alignment = normal.dot((cameras[c].Center() - centre).normalized());
-    if (alignment > best_alignment) {
-      best_alignment = alignment;
-      best = static_cast<int>(c);
-    }
-  }
-  return best;
+  return MostFrontalCamera(centre, normal, cameras, [&](int c) {
+    return visible[c][corners[0]] && visible[c][corners[1]] && visible[c][corners[2]];
+  });
 }
 
 // The images side by side (top-aligned, black below a shorter one); `offsets[c]` receives the

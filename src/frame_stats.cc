@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -206,6 +207,14 @@ FrameStats ParseFrameStats(const std::string& line, const std::string& where) {
   }
   Require(has_frame, where, "missing key \"frame\"");
   return stats;
+}
+
+FrameStats ReadFrameStats(const std::string& path) {
+  std::ifstream file(path);
+  Require(file.good(), path, "cannot open the statistics record");
+  std::string line;
+  std::getline(file, line);
+  return ParseFrameStats(line, path);
 }
 
 }  // namespace finecap

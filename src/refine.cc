@@ -246,7 +246,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   // With no surface Gaussian (no camera sees a refined vertex) the input is all there is.
   result.kept_input = (result.worse && options.keep_input_if_worse) || k.size() == 0;
 
-  const double bias = options.bias_compensation ? options.sigma_hat : 0.0;
+  const double bias = BiasCompensation(options);
   result.refined = frame.fine;
   result.k = Eigen::VectorXd::Constant(frame.fine.num_vertices(), std::nan(""));
   const std::vector<int>& ids = energy.surface().vertex_ids;
@@ -261,6 +261,16 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
 }
 
 }  // namespace
+
+double BiasCompensation(const RefineOptions& options) {
+  return options.bias_compensation ? options.sigma_hat : 0.0;
+}
+
+Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
+                                   const RefineOptions& options) {
+  if (kept_input) return k;
+  return k.array() - BiasCompensation(options);
+}
 
 void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
   result->refined = fine_input;

@@ -9,27 +9,10 @@
 #include "finecap/error.h"
 #include "finecap/surface_color_similarity.h"
 #include "finecap/surface_projection.h"
+#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {
-
-// The camera whose viewing direction (from the vertex towards the camera) aligns best with the
-// normal, among those that see the vertex; -1 when none does.
-int BestAlignedCamera(const Eigen::Vector3d& vertex, const Eigen::Vector3d& normal,
-                      const std::vector<Camera>& cameras,
-                      const std::vector<std::vector<unsigned char>>& visible, int v) {
-  int best = -1;
-  double best_alignment = -2.0;
-  for (size_t c = 0; c < cameras.size(); ++c) {
-    if (!visible[c][v]) continue;
-    const double alignment = normal.dot((cameras[c].Center() - vertex).normalized());
-    if (alignment > best_alignment) {
-      best_alignment = alignment;
-      best = static_cast<int>(c);
-    }
-  }
-  return best;
-}
 
 // Mean of the pixels of `image` (CV_32FC3) under a Gaussian of standard deviation `sigma` pixels
 // centred at `mean`, weighted by the Gaussian, out to two standard deviations.
@@ -74,7 +57,8 @@ ReferenceColors ColorFromBestCameras(const Eigen::Matrix3Xd& vertices,
   result.valid.assign(n, 0);
 #pragma omp parallel for schedule(dynamic, 256)
   for (int v = 0; v < n; ++v) {
-    const int c = BestAlignedCamera(vertices.col(v), normals.col(v), cameras, visible, v);
+    const int c = MostFrontalCamera(vertices.col(v), normals.col(v), cameras,
+                                    [&](int camera) { return visible[camera][v] != 0; });
     if (c < 0) continue;
     const ProjectedGaussian projected =
         ProjectSurfaceGaussian(cameras[c], vertices.col(v), normals.col(v), 0.0, sigma_hat);
@@ -127,8 +111,9 @@ void WriteReferenceColors(const std::string& path, const ReferenceColors& colors
       << "# the vertex in the reference frame.\n"
       << "color_space " << ColorSpaceName(colors.color_space) << "\n"
       << std::setprecision(9) << "sigma_hat " << colors.sigma_hat << "\n"
-      << "method " << EnumToString(colors.method) << "\n"
-      << "vertices " << colors.colors.size() << "\n";
+      << "method " << EnumToString(colors.method) << "\n";
+  if (!colors.recipe.empty()) text << "recipe " << colors.recipe << "\n";
+  text << "vertices " << colors.colors.size() << "\n";
   for (size_t v = 0; v < colors.colors.size(); ++v) {
     const Eigen::Vector3f& c = colors.colors[v];
     text << int(colors.valid[v]) << " " << c(0) << " " << c(1) << " " << c(2) << "\n";
@@ -142,9 +127,12 @@ ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertic
   std::string line, word, space_name;
   ReferenceColors colors;
   int count = -1;
-  const auto read_header = [&](const std::string& key, auto* value) {
+  const auto next_line = [&] {
     while (std::getline(stream, line) && (line.empty() || line[0] == '#')) {
     }
+  };
+  const auto read_header = [&](const std::string& key, auto* value, bool read_line = true) {
+    if (read_line) next_line();
     std::istringstream fields(line);
     Require(static_cast<bool>(fields >> word >> *value) && word == key, path,
             "expected '" + key + " <value>', got '" + line + "'");
@@ -157,7 +145,13 @@ ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertic
   Require(
       StringToEnum(method_name, &colors.method), path,
       "unknown method '" + method_name + "'; expected " + JoinedEnumNames<ReferenceColorSource>());
-  read_header("vertices", &count);
+  next_line();
+  const std::string recipe_key = "recipe ";
+  if (line.compare(0, recipe_key.size(), recipe_key) == 0) {  // Absent from older files.
+    colors.recipe = line.substr(recipe_key.size());
+    next_line();
+  }
+  read_header("vertices", &count, false);
   Require(count >= 0, path, "negative vertex count");
   Require(expected_vertices < 0 || count == expected_vertices, path,
           "made for " + std::to_string(count) + " vertices, but the mesh has " +

@@ -26,6 +26,7 @@ namespace fs = std::filesystem;
 using testing_util::ExpectErrorMentions;
 using testing_util::FileBytes;
 using testing_util::MakeTempDir;
+using testing_util::OneWorkerThread;
 
 // A skirt with folds from frame 0, seen by 8 cameras at 1.6 m that resolve them (~4 mm per
 // pixel; the folds shift the texture by a few pixels between neighbouring views).
@@ -132,13 +133,6 @@ Config HeldOutRunConfig(const std::string& capture, const std::string& out) {
 FrameStats FirstRecord(const std::string& out) {
   return ParseFrameStats(FileBytes(out + "/frames/000000.json"), out);
 }
-
-// One OpenMP thread while in scope: the energy's sums then come out the same on every
-// evaluation (an unmoved surface's energy equals its start exactly, two runs give the same bytes).
-struct OneWorkerThread {
-  OneWorkerThread() { SetWorkerThreads(1); }
-  ~OneWorkerThread() { SetWorkerThreads(0); }
-};
 
 TEST(HeldOutRefineTest, HeldOutCamerasAreScoredButNeverUsed) {
   const OneWorkerThread one_thread;  // Byte-equal results from run to run.

@@ -9,6 +9,7 @@
 #include "finecap/camera_io.h"
 #include "finecap/capture.h"
 #include "finecap/commands.h"
+#include "finecap/frame_reader.h"
 #include "finecap/frame_stats.h"
 #include "finecap/mesh_diagnostics.h"
 #include "finecap/mesh_io.h"
@@ -33,13 +34,10 @@ std::string MakeTinyCapture(const std::string& name) {
   return dir;
 }
 
+// Frame 0 of the capture in `capture_dir`.
 FrameInput ReadFrame(const std::string& capture_dir) {
   Capture capture = Capture::Open(capture_dir);
-  FrameInput input;
-  input.coarse = capture.ReadCoarseMesh(0);
-  input.cameras = capture.cameras();
-  for (int c = 0; c < capture.num_cameras(); ++c) input.images.push_back(capture.ReadImage(c, 0));
-  return input;
+  return ReadFrameInput(&capture, 0);
 }
 
 RefineOptions FastOptions() {

@@ -3,21 +3,12 @@
 #include <gtest/gtest.h>
 
 #include "finecap/capture.h"
+#include "finecap/frame_reader.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 
 namespace finecap {
 namespace {
-
-FrameInput ReadFrame(Capture* capture, int frame) {
-  FrameInput input;
-  input.coarse = capture->ReadCoarseMesh(frame);
-  input.cameras = capture->cameras();
-  for (int c = 0; c < capture->num_cameras(); ++c) {
-    input.images.push_back(capture->ReadImage(c, frame));
-  }
-  return input;
-}
 
 class RefineFrameTest : public ::testing::Test {
  protected:
@@ -38,9 +29,9 @@ TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
   Capture capture = Capture::Open(*directory_);
   RefineOptions options;
   options.visibility.max_view_angle_deg = 60.0;
-  const FrameInput input = ReadFrame(&capture, 1);
+  const FrameInput input = ReadFrameInput(&capture, 1);
   const SequenceModel model(input.coarse, {}, options, "test");
-  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrame(&capture, 0), options);
+  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrameInput(&capture, 0), options);
 
   const FrameResult single = RefineFrame(model, colors, input, options);
   options.coarse_to_fine.levels = 2;
@@ -62,9 +53,9 @@ TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
 TEST_F(RefineFrameTest, EntryPointsRefuseBadOptionsNamingTheField) {
   Capture capture = Capture::Open(*directory_);
   const RefineOptions options;
-  const FrameInput input = ReadFrame(&capture, 1);
+  const FrameInput input = ReadFrameInput(&capture, 1);
   const SequenceModel model(input.coarse, {}, options, "test");
-  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrame(&capture, 0), options);
+  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrameInput(&capture, 0), options);
 
   RefineOptions bad = options;
   bad.sigma_hat = -0.007;
@@ -81,7 +72,7 @@ TEST_F(RefineFrameTest, EntryPointsRefuseBadOptionsNamingTheField) {
   bad = options;
   bad.reference_colors = static_cast<ReferenceColorSource>(7);
   testing_util::ExpectErrorMentions(
-      [&] { ComputeSequenceColors(model, ReadFrame(&capture, 0), bad); },
+      [&] { ComputeSequenceColors(model, ReadFrameInput(&capture, 0), bad); },
       {"RefineOptions::reference_colors", "not a valid choice"});
   bad = options;
   bad.sweep.samples = 2;

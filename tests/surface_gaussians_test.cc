@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "energy_fixture.h"
 #include "finecap/error.h"
+#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {
@@ -18,6 +20,7 @@ ReferenceColors SomeColors() {
   colors.colors = {Eigen::Vector3f(0.1f, 0.25f, 0.6f), Eigen::Vector3f(0.3f, 0.3f, 0.3f),
                    Eigen::Vector3f(0.0f, 0.0f, 0.0f)};
   colors.valid = {1, 1, 0};
+  colors.recipe = "reference_frame=0 sigma_hat=0.0055 held_out=";
   return colors;
 }
 
@@ -33,8 +36,26 @@ TEST(ReferenceColorsTest, RoundTripKeepsEveryField) {
   EXPECT_EQ(read.color_space, written.color_space);
   EXPECT_DOUBLE_EQ(read.sigma_hat, written.sigma_hat);
   EXPECT_EQ(read.method, ReferenceColorSource::kImageModel);
+  EXPECT_EQ(read.recipe, written.recipe);
   EXPECT_EQ(read.valid, written.valid);
   for (int v = 0; v < 3; ++v) EXPECT_LT((read.colors[v] - written.colors[v]).norm(), 1e-7f);
+}
+
+// Cameras at 0.6, 0 and -0.3 radians about the point at the origin, whose normal faces -z tilted
+// towards the first: the first sees it most frontally, unless it does not see it at all.
+TEST(MostFrontalCameraTest, PicksTheCameraFacingTheNormalAmongThoseThatSeeThePoint) {
+  const std::vector<Camera> cameras = {LookAtOrigin(1.0, 0.6, 400.0, 100),
+                                       LookAtOrigin(1.0, 0.0, 400.0, 100),
+                                       LookAtOrigin(1.0, -0.3, 400.0, 100)};
+  const Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d normal = Eigen::Vector3d(std::sin(0.5), 0.0, -std::cos(0.5));
+  const auto all = [](int) { return true; };
+  EXPECT_EQ(MostFrontalCamera(point, normal, cameras, all), 0);
+  EXPECT_EQ(MostFrontalCamera(point, 3.0 * normal, cameras, all), 0);  // Only its direction.
+  EXPECT_EQ(MostFrontalCamera(point, normal, cameras, [](int c) { return c != 0; }), 1);
+  EXPECT_EQ(MostFrontalCamera(point, normal, cameras, [](int) { return false; }), -1);
+  // Facing away from every camera still picks the least oblique of those that see it.
+  EXPECT_EQ(MostFrontalCamera(point, -3.0 * normal, cameras, all), 2);
 }
 
 TEST(ReferenceColorsTest, WrongVertexCountAndTruncationAreNamed) {

@@ -15,9 +15,17 @@
 #include <gtest/gtest.h>
 
 #include "finecap/error.h"
+#include "finecap/threads.h"
 
 namespace finecap {
 namespace testing_util {
+
+// One OpenMP thread while in scope: the energy's sums then come out the same on every
+// evaluation (an unmoved surface's energy equals its start exactly, two runs give the same bytes).
+struct OneWorkerThread {
+  OneWorkerThread() { SetWorkerThreads(1); }
+  ~OneWorkerThread() { SetWorkerThreads(0); }
+};
 
 // A fresh, empty folder under the test temp dir, unique per process and call.
 inline std::string MakeTempDir(const std::string& name) {

@@ -11,11 +11,6 @@
 
 namespace finecap {
 
-// Reads one frame's statistics record as `finecap refine` writes it (frames/<frame>.json; null
-// numbers read as NaN). Throws Error naming the file when it is missing, malformed or lacks a
-// field.
-FrameStats ReadFrameStats(const std::string& path);
-
 // One variant over the frames it refined. Energies are means over the frames (they differ from
 // frame to frame, so only variants on the same frames compare); errors are root mean squares of
 // the per-frame RMS, millimetres; times are medians over the frames, seconds.

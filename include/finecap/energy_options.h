@@ -80,11 +80,15 @@ struct EnergyOptions {
   // paper. Default 0.
   double w_prior = 0.0;
   // Strength mu of a pull towards the input surface on wide plain regions of the cloth, in units
-  // of the median data curvature (input_prior.h). Not in the paper. 0 turns it off. Default 300:
-  // on synth_textureless (frames 1-9) the plain band keeps the input's error (7.70 -> 7.70 mm
-  // RMS; 10.3 mm without the pull) and the textured part improves too (5.39 -> 4.17 mm), while
-  // synth_skirt, textured throughout, is all but unchanged (2.52 -> 2.54 mm).
-  double confidence_prior = 300.0;
+  // of the median data curvature (input_prior.h). Not in the paper. 0 turns it off, the default:
+  // the consensus similarity weights each patch by its contrast at the input, so plain cloth
+  // already carries no weight, and the pull only held detail back (synth_textureless frames 1-9:
+  // plain band 7.12 mm RMS with the pull at 300, 5.94 mm without, input 8.37 mm; synth_skirt
+  // frames 0-5: 60.8 % of the detail recovered with it, 62.6 % without; the Middlebury temple's
+  // held-out NCC 0.560 with it, 0.624 without). surface_color needs it (configs/surface_color.yaml
+  // sets 300): without it the band of synth_textureless ended worse than the input (7.70 ->
+  // 10.3 mm; 7.70 mm with it).
+  double confidence_prior = 0.0;
   // The consensus similarity's options.
   ConsensusOptions consensus;
   // Colour variation, as a fraction of its median, below which the cloth counts as plain (the

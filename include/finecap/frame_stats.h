@@ -73,6 +73,11 @@ std::string ToJson(const FrameStats& stats);
 // except "frame", which is required. Numbers come back as ToJson rounded them (10 digits).
 FrameStats ParseFrameStats(const std::string& line, const std::string& where);
 
+// Reads one frame's statistics record as a run folder holds it (frames/<frame>.json; null
+// numbers read as NaN). Throws Error naming the file when it is missing, malformed or lacks a
+// field.
+FrameStats ReadFrameStats(const std::string& path);
+
 }  // namespace finecap
 
 #endif  // FINECAP_FRAME_STATS_H_

@@ -181,6 +181,18 @@ struct FrameResult {
   double seconds_total = 0.0;        // The whole frame.
 };
 
+// What bias compensation adds along the normal to every solved displacement of a frame that was
+// refined: sigma_hat with RefineOptions::bias_compensation, else 0. A kept input gets nothing.
+double BiasCompensation(const RefineOptions& options);
+
+// The one rule that takes a frame's written displacement (FrameResult::k, or its saved k/ file)
+// back to where its solve ended, per fine vertex: k minus the bias compensation, except for a frame
+// whose input was kept (`kept_input`), whose 0 is the input surface as the solver would start it.
+// NaN stays NaN. This is what seeds the next frame (warm start) and where a result's energy is
+// measured.
+Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
+                                   const RefineOptions& options);
+
 // Puts the input surface back into `result` (its refined mesh, normals and k, which becomes 0
 // wherever it was refined) and sets kept_input, for a frame that another measure than the energy
 // found worse. `fine_input` is the frame's subdivided input mesh.

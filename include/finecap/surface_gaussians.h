@@ -41,8 +41,11 @@ struct ReferenceColors {
   ColorSpace color_space = ColorSpace::kHsv;
   double sigma_hat = 0.007;  // The footprint they were averaged over, metres.
   ReferenceColorSource method = ReferenceColorSource::kPixels;  // How they were taken.
-  std::vector<Eigen::Vector3f> colors;                          // One per mesh vertex.
-  std::vector<unsigned char> valid;                             // 1 where a camera saw the vertex.
+  // What they were computed from, one line (ReferenceColorRecipe, sequence.h); saved in the file
+  // so that a run reusing it can check it. Empty in files saved before recipes were.
+  std::string recipe;
+  std::vector<Eigen::Vector3f> colors;  // One per mesh vertex.
+  std::vector<unsigned char> valid;     // 1 where a camera saw the vertex.
 };
 
 // The paper's colouring: for each vertex, the camera that sees it best (visible, and whose

@@ -4,6 +4,7 @@
 #ifndef FINECAP_VISIBILITY_H_
 #define FINECAP_VISIBILITY_H_
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -38,6 +39,27 @@ std::vector<unsigned char> ComputeVisibility(const Camera& camera, const cv::Mat
                                              const Eigen::Matrix3Xd& points,
                                              const Eigen::Matrix3Xd& normals,
                                              const VisibilityOptions& options);
+
+// The camera that sees `point` most frontally: among the cameras c for which `sees(c)` holds,
+// the one whose direction from `point` aligns best with `normal` (largest dot product; `normal`
+// need not be unit, only its direction matters for the choice), the first of equals; -1 when
+// none sees it. The one rule by which a surface point takes its colour from one camera (the
+// reference colours, the texture of the flow evaluation).
+template <typename Sees>
+int MostFrontalCamera(const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                      const std::vector<Camera>& cameras, const Sees& sees) {
+  int best = -1;
+  double best_alignment = -std::numeric_limits<double>::infinity();
+  for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
+    if (!sees(c)) continue;
+    const double alignment = normal.dot((cameras[c].Center() - point).normalized());
+    if (alignment > best_alignment) {
+      best_alignment = alignment;
+      best = c;
+    }
+  }
+  return best;
+}
 
 }  // namespace finecap
 

@@ -9,10 +9,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "commands/run_folder.h"
 #include "finecap/error.h"
-#include "finecap/ground_truth.h"
-#include "io_util.h"
+#include "finecap/mesh_io.h"
 
 namespace finecap {
 namespace internal {
@@ -52,32 +50,6 @@ Capture OpenConfiguredCapture(const Config& config) {
   Capture capture = Capture::Open(config.capture.dir);
   CheckHeldOutCameras(config, capture);
   return capture;
-}
-
-std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input) {
-  std::vector<CalibratedImage> held_out;
-  FrameInput training;
-  training.coarse = std::move(input->coarse);
-  for (size_t c = 0; c < input->cameras.size(); ++c) {
-    if (IsHeldOut(config, input->cameras[c].name)) {
-      held_out.push_back({input->cameras[c], input->images[c]});
-    } else {
-      training.cameras.push_back(input->cameras[c]);
-      training.images.push_back(input->images[c]);
-    }
-  }
-  *input = std::move(training);
-  Require(!input->cameras.empty(), "validation.cameras",
-          "no camera other than the held-out ones could be read");
-  return held_out;
-}
-
-std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
-  std::vector<CalibratedImage> views;
-  for (size_t c = 0; c < input.cameras.size(); ++c) {
-    views.push_back({input.cameras[c], input.images[c]});
-  }
-  return views;
 }
 
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture) {
@@ -151,104 +123,114 @@ std::string RefinedRunFolder(const Config& config) {
   return fs::canonical(config.output.dir).string();
 }
 
-FrameInput ReadFrameInput(Capture* capture, int frame) {
-  return ReadFrameInput(capture, frame, false, nullptr);
+SequenceOptions SequenceOptionsOf(const Config& config) {
+  SequenceOptions options;
+  options.refine = config.refine;
+  options.reference_frame = config.reference_frame;
+  options.held_out_cameras = config.validation.cameras;
+  options.held_out_score = config.validation.score;
+  options.skip_unreadable_cameras = config.capture.skip_unreadable_cameras;
+  options.mesh_format = MeshFormatOf(config);
+  return options;
 }
 
-FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
-                          std::vector<std::string>* skipped) {
-  FrameInput input;
-  input.coarse = capture->ReadCoarseMesh(frame);
-  std::string first_error;
-  for (int c = 0; c < capture->num_cameras(); ++c) {
-    const Camera& camera = capture->cameras()[c];
-    try {
-      input.images.push_back(capture->ReadImage(c, frame));
-      input.cameras.push_back(camera);
-    } catch (const Error& error) {
-      if (!skip_unreadable) throw;
-      if (first_error.empty()) first_error = error.what();
-      std::cerr << "finecap: warning: frame " << capture->frame_name(frame) << " without camera "
-                << camera.name << " (capture.skip_unreadable_cameras): " << error.what() << "\n";
-      if (skipped != nullptr) skipped->push_back(camera.name);
+MeshFormat MeshFormatOf(const Config& config) {
+  return config.output.mesh_format == "obj" ? MeshFormat::kObj : MeshFormat::kPly;
+}
+
+namespace {
+
+void WarnSkipped(const std::string& frame, const SkippedCamera& camera) {
+  std::cerr << "finecap: warning: frame " << frame << " without camera " << camera.camera
+            << " (capture.skip_unreadable_cameras): " << camera.error << "\n";
+}
+
+// A sequence's progress as `finecap <command>` shows it.
+class ConsoleObserver : public SequenceObserver {
+ public:
+  ConsoleObserver(const std::string& command, int num_frames)
+      : command_(command), progress_(num_frames) {}
+
+  void StaleFilesRemoved(int count) override {
+    std::cerr << "finecap " << command_ << ": removed " << count << " files a killed run left\n";
+  }
+  void Starting(int num_frames, const FrameInput& first, const ProblemSize& size) override {
+    const Camera& camera = first.cameras.front();
+    std::cerr << "finecap " << command_ << ": " << num_frames << " frames, " << first.cameras.size()
+              << " cameras of " << camera.width << "x" << camera.height << ", "
+              << size.num_surface_gaussians << " surface Gaussians (of " << size.num_fine_vertices
+              << " vertices after subdivision), about " << RoundedCount(size.num_pairs)
+              << " pairs; expected peak memory " << std::lround(size.peak_memory_mb)
+              << " MB, about " << RoundedSeconds(size.seconds_per_frame) << " per frame\n";
+  }
+  void CameraSkipped(const std::string& frame, const SkippedCamera& camera) override {
+    WarnSkipped(frame, camera);
+  }
+  void NothingToRefine(const std::string& frame) override {
+    std::cerr << "finecap " << command_ << ": warning: frame " << frame
+              << ": no camera sees any vertex to refine (the mesh is behind every camera or "
+                 "out of view); the input surface is written\n";
+  }
+  void FrameAlreadyDone(const std::string& frame) override { progress_.FrameDone(frame, true, ""); }
+  void FrameRefined(const FrameStats& stats) override {
+    std::ostringstream detail;
+    detail.precision(3);
+    detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
+           << " iterations";
+    if (std::isfinite(stats.heldout_ncc_input)) {
+      detail << ", held-out NCC " << stats.heldout_ncc_input << " -> " << stats.heldout_ncc_refined;
     }
+    detail << (stats.worse ? ", WORSE" : "") << (stats.kept_input ? " (input kept)" : "");
+    if (std::isfinite(stats.rms_refined_mm)) {
+      detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
+    }
+    progress_.FrameDone(stats.frame, false, detail.str());
   }
-  Require(!input.cameras.empty(), "",
-          first_error + " (and no other camera's image of frame " + capture->frame_name(frame) +
-              " could be read either)");
-  return input;
+
+ private:
+  std::string command_;
+  Progress progress_;
+};
+
+}  // namespace
+
+ReferenceColors ConfiguredReferenceColors(const Config& config, const SequenceModel& model,
+                                          Capture* capture, const std::string& out) {
+  std::vector<SkippedCamera> skipped;
+  ReferenceColors colors = LoadOrComputeReferenceColors(model, SequenceOptionsOf(config), capture,
+                                                        ReferenceColorsPath(out), &skipped);
+  for (const SkippedCamera& camera : skipped) {
+    WarnSkipped(capture->frame_name(config.reference_frame), camera);
+  }
+  return colors;
 }
 
-ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
-                                             Capture* capture, const std::string& path) {
-  if (fs::exists(path)) {
-    ReferenceColors saved = ReadReferenceColors(path, model.num_fine_vertices());
-    const RefineOptions& options = config.refine;
-    // The file holds sigma_hat to 9 significant digits, which a length chosen from the scene
-    // needs all of.
-    Require(saved.color_space == options.image.color_space &&
-                std::abs(saved.sigma_hat - options.sigma_hat) <= 1e-8 * options.sigma_hat &&
-                saved.method == options.reference_colors,
-            path,
-            "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +
-                std::to_string(saved.sigma_hat) + " and method " + EnumToString(saved.method) +
-                ", but the config asks for " + ColorSpaceName(options.image.color_space) + ", " +
-                std::to_string(options.sigma_hat) + " and " +
-                EnumToString(options.reference_colors) + ": use another output folder");
-    return saved;
+void RefineConfiguredSequence(const Config& config, const FrameRange& frames,
+                              const std::string& out, const std::string& command,
+                              Capture* capture) {
+  ConsoleObserver observer(command, frames.size());
+  const SequenceResult result =
+      RefineSequence(capture, frames, SequenceOptionsOf(config), out, &observer);
+  if (frames.size() == 0) {
+    std::cout << "Shard " << config.runtime.shard.ToString() << " holds none of the "
+              << ConfiguredFrames(config, *capture).size() << " configured frames\n";
+    return;
   }
-  Require(config.reference_frame < capture->num_frames(), "model.reference_frame",
-          "frame " + std::to_string(config.reference_frame) + " does not exist in " +
-              capture->directory());
-  FrameInput reference = ReadFrameInput(capture, config.reference_frame,
-                                        config.capture.skip_unreadable_cameras, nullptr);
-  TakeHeldOutViews(config, &reference);  // Held-out cameras colour nothing.
-  WriteReferenceColors(path, ComputeSequenceColors(model, reference, config.refine));
-  // As saved: every run and shard on this folder then starts from the very same colours.
-  return ReadReferenceColors(path, model.num_fine_vertices());
-}
-
-Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
-                                     const Mesh& coarse, int frame) {
-  if (!capture.HasTrueSurface(frame)) return {};
-  const Mesh fine = model.Subdivide(coarse);
-  return TrueDisplacementAlongNormals(fine.vertices, ComputeVertexNormals(fine),
-                                      capture.ReadTrueSurface(frame), 0.1);
+  std::cout << "Refined meshes: " << out << "/meshes/, displacements: " << out
+            << "/k/, statistics: " << out << "/stats.jsonl\n";
+  if (result.measured > 0) {
+    std::cout.precision(3);
+    std::cout << "Error against the ground truth (textured region, RMS over the frames run now): "
+              << "input " << result.rms_coarse_mm << " mm, refined " << result.rms_refined_mm
+              << " mm, detail recovered "
+              << 100.0 * (1.0 - result.rms_refined_mm / result.rms_coarse_mm) << " %\n";
+  }
 }
 
 std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
                                             const std::string& out) {
-  const FrameRange range = internal::ConfiguredFrames(config, capture);
-  std::vector<RefinedFrame> frames;
-  for (int frame = range.begin; frame < range.end; ++frame) {
-    const std::string& name = capture.frame_name(frame);
-    const FrameFiles files = FrameFilesIn(out, name, config.output.mesh_format);
-    if (FrameDone(files)) frames.push_back({frame, name, files.mesh, files.displacement});
-  }
-  Require(!frames.empty(), out,
-          "holds no refined run of the configured frames of " + capture.directory() +
-              " (no meshes/<frame>." + config.output.mesh_format +
-              " with k/<frame>.txt and frames/<frame>.json): run finecap refine first");
-  return frames;
-}
-
-// A k/<frame>.txt file: one number (or nan) per fine vertex, '#' lines are comments.
-Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
-  std::istringstream text(internal::ReadWholeFile(path));
-  std::vector<double> values;
-  std::string line;
-  for (int line_number = 1; std::getline(text, line); ++line_number) {
-    if (line.empty() || line[0] == '#') continue;
-    double value = 0.0;
-    Require(
-        internal::ParseDouble(line, &value) && !std::isinf(value), path,
-        "line " + std::to_string(line_number) + ": expected a number or nan, got '" + line + "'");
-    values.push_back(value);
-  }
-  Require(static_cast<int>(values.size()) == num_vertices, path,
-          "holds " + std::to_string(values.size()) + " displacements, the refined mesh has " +
-              std::to_string(num_vertices) + " vertices");
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+  return finecap::FindRefinedFrames(out, capture.frame_names(), ConfiguredFrames(config, capture),
+                                    MeshFormatOf(config), capture.directory());
 }
 
 Progress::Progress(int total)

@@ -1,5 +1,5 @@
-// What the subcommands share: opening the input capture, preparing the output folder, reading
-// one frame, the reference colours, and progress output.
+// What the subcommands share: opening the input capture, preparing the output folder, the
+// library's options from the config, a sequence refined with its progress on the terminal.
 #ifndef FINECAP_SRC_COMMANDS_COMMAND_UTIL_H_
 #define FINECAP_SRC_COMMANDS_COMMAND_UTIL_H_
 
@@ -11,7 +11,9 @@
 #include "finecap/config.h"
 #include "finecap/heldout_score.h"
 #include "finecap/refine.h"
+#include "finecap/run_folder.h"
 #include "finecap/scene_scale.h"
+#include "finecap/sequence.h"
 
 namespace finecap {
 namespace internal {
@@ -20,14 +22,6 @@ namespace internal {
 // validation.cameras when one of its names is not a camera of the capture or when it holds out
 // every camera.
 Capture OpenConfiguredCapture(const Config& config);
-
-// Removes the held-out cameras (validation.cameras) and their images from `input` and returns
-// them, in the rig's order: what is left is all that refinement may see. Throws Error when no
-// other camera is left (the others' images could not be read).
-std::vector<CalibratedImage> TakeHeldOutViews(const Config& config, FrameInput* input);
-
-// The cameras and images of `input`, for the held-out score.
-std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // The configured frames of `capture`; an Error when the range holds none of its frames.
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture);
@@ -52,39 +46,25 @@ std::string RoundedCount(double count);
 // A duration for people: "0.8 s", "12 s", "3.5 min".
 std::string RoundedSeconds(double seconds);
 
-// The coarse mesh, cameras and undistorted images of one frame.
-FrameInput ReadFrameInput(Capture* capture, int frame);
+// What the library's sequence and run folder take from the config.
+SequenceOptions SequenceOptionsOf(const Config& config);
+MeshFormat MeshFormatOf(const Config& config);
 
-// The same, except that with `skip_unreadable` a camera whose image cannot be read is left out of
-// the frame (with a warning on stderr) and its name appended to `*skipped` (which may be null
-// otherwise). When no camera's image can be read, the first camera's error is thrown.
-FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
-                          std::vector<std::string>* skipped);
+// The reference colours of the run folder `out` (LoadOrComputeReferenceColors), with a warning on
+// stderr for each camera skipped in the reference frame.
+ReferenceColors ConfiguredReferenceColors(const Config& config, const SequenceModel& model,
+                                          Capture* capture, const std::string& out);
 
-// The reference colours saved in `path`, or, when there is no such file, those of the
-// configured reference frame, computed, saved there and read back (so a run uses exactly what a
-// later resumed run or shard will read).
-ReferenceColors LoadOrComputeReferenceColors(const Config& config, const SequenceModel& model,
-                                             Capture* capture, const std::string& path);
+// Refines `frames` of `capture` into `out` (RefineSequence) as `finecap <command>` shows it: the
+// problem size first, then a progress line per frame and warnings on stderr; then where the
+// results are and, with ground truth, the error over the frames refined now on stdout.
+void RefineConfiguredSequence(const Config& config, const FrameRange& frames,
+                              const std::string& out, const std::string& command, Capture* capture);
 
-// The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
-// vector when the capture has no true surface for the frame.
-Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
-                                     const Mesh& coarse, int frame);
-
-// The files `finecap refine` wrote for one frame.
-struct RefinedFrame {
-  int index = 0;
-  std::string name, mesh, displacement;
-};
-
-// The configured frames done in `out` (mesh, displacement and stats record), in frame order;
-// an Error naming `out` when there is none.
+// The configured frames done in the run folder `out`, in frame order; an Error naming `out` when
+// there is none.
 std::vector<RefinedFrame> FindRefinedFrames(const Config& config, const Capture& capture,
                                             const std::string& out);
-
-// A k/<frame>.txt file: one number (or nan) per vertex of the refined mesh.
-Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices);
 
 // Progress of a run over frames: a line rewritten in place on a terminal, plain lines otherwise.
 class Progress {

@@ -14,20 +14,19 @@ namespace finecap {
 int RunExport(const Config& config) {
   Capture capture = internal::OpenConfiguredCapture(config);
   const std::string out = internal::RefinedRunFolder(config);
-  const std::vector<internal::RefinedFrame> frames =
-      internal::FindRefinedFrames(config, capture, out);
-  const std::string folder = out + "/export";
+  const std::vector<RefinedFrame> frames = internal::FindRefinedFrames(config, capture, out);
+  const std::string folder = ExportFolder(out);
   std::filesystem::create_directories(folder + "/ply");
 
-  const Mesh first = ReadMesh(frames.front().mesh);
+  const Mesh first = ReadMesh(frames.front().files.mesh);
   WriteMesh(folder + "/first_frame.ply", first, {ComputeVertexNormals(first), {}, {}});
   // Frames run one at a time: memory does not grow with the sequence.
   Pc2Writer cache(folder + "/sequence.pc2", first.num_vertices(),
                   static_cast<float>(frames.front().index));
-  for (const internal::RefinedFrame& frame : frames) {
-    const Mesh mesh = ReadMesh(frame.mesh);
-    RequireSameTopology(first, mesh, frame.mesh);
-    const Eigen::VectorXd k = internal::ReadDisplacement(frame.displacement, mesh.num_vertices());
+  for (const RefinedFrame& frame : frames) {
+    const Mesh mesh = ReadMesh(frame.files.mesh);
+    RequireSameTopology(first, mesh, frame.files.mesh);
+    const Eigen::VectorXd k = ReadDisplacement(frame.files.displacement, mesh.num_vertices());
     cache.Append(mesh.vertices);
     WriteDisplacementPly(folder + "/ply/" + frame.name + ".ply", mesh,
                          k.array().isFinite().select(k, 0.0));

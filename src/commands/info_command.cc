@@ -66,12 +66,12 @@ int RunInfo(const Config& configured) {
 
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.mesh_path(0));
-  FrameInput reference = internal::ReadFrameInput(&capture, config.reference_frame);
-  internal::TakeHeldOutViews(config, &reference);  // As refine colours the surface.
+  FrameInput reference = ReadFrameInput(&capture, config.reference_frame);
+  TakeHeldOutViews(config.validation.cameras, &reference);  // As refine colours the surface.
   const ReferenceColors colors = ComputeSequenceColors(model, reference, config.refine);
   const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
-  FrameInput input = internal::ReadFrameInput(&capture, first);
-  const std::vector<CalibratedImage> held_out = internal::TakeHeldOutViews(config, &input);
+  FrameInput input = ReadFrameInput(&capture, first);
+  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config.validation.cameras, &input);
   const ProblemSize size = EstimateProblemSize(model, colors, input, config.refine);
 
   std::cout << "capture: " << capture.directory() << "\n";

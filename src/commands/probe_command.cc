@@ -71,15 +71,13 @@ int RunProbe(const Config& configured, int frame_index) {
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture.directory() + "/meshes");
   const std::string out = ProbeOutputFolder(config, capture);
-  const ReferenceColors colors = internal::LoadOrComputeReferenceColors(
-      config, model, &capture, out + "/reference_colors.txt");
-  FrameInput input = internal::ReadFrameInput(&capture, frame);
-  internal::TakeHeldOutViews(config, &input);  // The energy as refine sees it.
+  const ReferenceColors colors = internal::ConfiguredReferenceColors(config, model, &capture, out);
+  FrameInput input = ReadFrameInput(&capture, frame);
+  TakeHeldOutViews(config.validation.cameras, &input);  // The energy as refine sees it.
   PreparedFrame prepared = PrepareFrame(model, colors, input, config.refine);
   const FrameEnergy& energy = *prepared.energy;
 
-  const Eigen::VectorXd truth_all =
-      internal::TrueFineDisplacement(capture, model, input.coarse, frame);
+  const Eigen::VectorXd truth_all = TrueFineDisplacement(capture, model, input.coarse, frame);
   Eigen::VectorXd truth(energy.num_parameters());
   for (int s = 0; s < truth.size(); ++s) {
     const double k = truth_all[energy.surface().vertex_ids[s]];

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "commands/command_util.h"
-#include "commands/run_folder.h"
 #include "finecap/commands.h"
+#include "finecap/run_folder.h"
 #include "finecap/shard.h"
 
 namespace finecap {
@@ -21,10 +21,10 @@ std::string DescribeFrames(const Capture& capture, const FrameRange& missing) {
 
 // The runs of consecutive frames of `frames` that are not done in `out`.
 std::vector<FrameRange> MissingRuns(const Capture& capture, const FrameRange& frames,
-                                    const std::string& out, const std::string& mesh_format) {
+                                    const std::string& out, MeshFormat mesh_format) {
   std::vector<FrameRange> runs;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
-    if (internal::FrameDone(internal::FrameFilesIn(out, capture.frame_name(frame), mesh_format))) {
+    if (FrameDone(FrameFilesIn(out, capture.frame_name(frame), mesh_format))) {
       continue;
     }
     if (!runs.empty() && runs.back().end == frame) {
@@ -44,7 +44,7 @@ int RunStatus(const Config& config) {
       ShardOf(internal::ConfiguredFrames(config, capture), config.runtime.shard);
   const std::string out = internal::RefinedRunFolder(config);
   const std::vector<FrameRange> missing =
-      MissingRuns(capture, frames, out, config.output.mesh_format);
+      MissingRuns(capture, frames, out, internal::MeshFormatOf(config));
   int missing_count = 0;
   for (const FrameRange& run : missing) missing_count += run.size();
 

@@ -1,11 +1,11 @@
-#include "commands/heldout_eval.h"
+#include "heldout_eval.h"
 
 #include <cmath>
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
-#include "commands/command_util.h"
+#include "finecap/frame_reader.h"
 #include "io_util.h"
 
 namespace finecap {
@@ -72,15 +72,15 @@ std::vector<TableCell> ScoreRow(const std::string& name, const std::string& trai
 
 }  // namespace
 
-HeldOutFrame EvaluateHeldOutFrame(const Config& config, const std::string& frame_name,
+HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
+                                  const HeldOutOptions& options, const std::string& frame_name,
                                   FrameInput frame, const Mesh& input, const Mesh& refined,
                                   const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures) {
-  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config, &frame);
+  const std::vector<CalibratedImage> held_out = TakeHeldOutViews(held_out_cameras, &frame);
   std::vector<HeldOutViewMaps> maps;
-  HeldOutFrame result{frame_name,
-                      ScoreHeldOutViews(CalibratedImagesOf(frame), held_out, {&input, &refined},
-                                        config.validation.score, &maps)};
+  HeldOutFrame result{frame_name, ScoreHeldOutViews(CalibratedImagesOf(frame), held_out,
+                                                    {&input, &refined}, options, &maps)};
   for (size_t h = 0; h < held_out.size(); ++h) {
     const cv::Mat& image = held_out[h].image;
     const cv::Rect box = WarpedBox(maps[h], image.size());

@@ -1,13 +1,12 @@
-// What `finecap eval` reports of the held-out cameras (validation.cameras): figures per frame and
-// pooled, pictures, their JSON and their report section.
-#ifndef FINECAP_SRC_COMMANDS_HELDOUT_EVAL_H_
-#define FINECAP_SRC_COMMANDS_HELDOUT_EVAL_H_
+// What the evaluation of a run (run_evaluation.h) reports of the held-out cameras: figures per
+// frame and pooled, pictures, their JSON and their report section.
+#ifndef FINECAP_SRC_HELDOUT_EVAL_H_
+#define FINECAP_SRC_HELDOUT_EVAL_H_
 
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "finecap/config.h"
 #include "finecap/heldout_score.h"
 #include "finecap/html_report.h"
 #include "finecap/refine.h"
@@ -22,10 +21,11 @@ struct HeldOutFrame {
   HeldOutScore score;
 };
 
-// Scores `input` and `refined` in the held-out views of `frame` (training views: the rest of
-// `frame`), writes one picture per held-out view to eval_dir/heldout_<frame>_<camera>.png and
-// appends its path and caption to `*pictures`.
-HeldOutFrame EvaluateHeldOutFrame(const Config& config, const std::string& frame_name,
+// Scores `input` and `refined` in the views of `frame` named in `held_out_cameras` (training
+// views: the rest of `frame`), writes one picture per held-out view to
+// eval_dir/heldout_<frame>_<camera>.png and appends its path and caption to `*pictures`.
+HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
+                                  const HeldOutOptions& options, const std::string& frame_name,
                                   FrameInput frame, const Mesh& input, const Mesh& refined,
                                   const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures);
@@ -45,4 +45,4 @@ void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOpt
 }  // namespace internal
 }  // namespace finecap
 
-#endif  // FINECAP_SRC_COMMANDS_HELDOUT_EVAL_H_
+#endif  // FINECAP_SRC_HELDOUT_EVAL_H_

@@ -1,0 +1,72 @@
+// A refined run folder (run_folder.h) measured: against the capture's ground truth when it has
+// one (evaluation.h), by optical flow to the images (flow_evaluation.h) and in the held-out
+// cameras (heldout_score.h). EvaluateRun writes its pictures, plots, metrics.json, flow.csv and
+// report.html into one folder, the run folder's eval/, and prints nothing: what a user should see
+// goes to an EvaluationObserver and into the RunEvaluation it returns.
+#ifndef FINECAP_RUN_EVALUATION_H_
+#define FINECAP_RUN_EVALUATION_H_
+
+#include <string>
+#include <vector>
+
+#include "finecap/capture.h"
+#include "finecap/evaluation.h"
+#include "finecap/flow_evaluation.h"
+#include "finecap/heldout_score.h"
+#include "finecap/optical_flow.h"
+#include "finecap/refine.h"
+#include "finecap/run_folder.h"
+
+namespace finecap {
+
+struct RunEvaluationOptions {
+  // What the run was refined with: its subdivision fixes the fine mesh, its visibility the
+  // texture the flow renders; its lengths should be resolved as they were (scene_scale.h).
+  RefineOptions refine;
+  // The frame whose images texture the model the flow renders (model.reference_frame). Default 0.
+  int reference_frame = 0;
+  // The camera whose view the per-frame pictures show, an index into the capture's cameras.
+  // Default 0.
+  int camera = 0;
+  // Measure the optical-flow figures; without, they are NaN (null in metrics.json). Default true.
+  bool measure_flow = true;
+  OpticalFlowOptions flow;
+  // The flow in every camera, their pixels pooled (default), or only in `camera`.
+  bool flow_in_all_cameras = true;
+  // The cameras the run held out (SequenceOptions::held_out_cameras): scored per frame, with
+  // pictures. Default none.
+  std::vector<std::string> held_out_cameras;
+  HeldOutOptions held_out_score;
+
+  void Check() const;
+};
+
+// What EvaluateRun tells its caller while it runs; every method does nothing unless overridden.
+class EvaluationObserver {
+ public:
+  virtual ~EvaluationObserver() = default;
+  virtual void FrameEvaluated(const std::string& /*frame*/) {}
+  // three.js was not found (mesh_viewer.h): the report has a note in place of its 3D view.
+  virtual void ViewerUnavailable() {}
+};
+
+// The headline figures of an evaluated run, and where its files are.
+struct RunEvaluation {
+  EvaluationFigures sequence;  // Every frame's vertices pooled.
+  bool flow_measured = false;
+  FlowComparison flow;                // Pooled over the frames and cameras.
+  std::vector<SurfaceScore> heldout;  // Input, refined; empty without held-out cameras.
+  std::string report, metrics;        // report.html and metrics.json.
+};
+
+// Evaluates `frames` of `capture` (the done frames of a run folder: FindRefinedFrames) into
+// `folder` (created when missing; EvalFolder of the run folder). Throws Error naming the file or
+// the option when an input cannot be read or `options` are invalid (Check()). `observer` may be
+// null.
+RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& frames,
+                          const RunEvaluationOptions& options, const std::string& folder,
+                          EvaluationObserver* observer = nullptr);
+
+}  // namespace finecap
+
+#endif  // FINECAP_RUN_EVALUATION_H_

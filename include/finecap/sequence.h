@@ -1,0 +1,122 @@
+// A sequence refined frame after frame into a run folder (run_folder.h): the library's frame loop.
+//
+// RefineSequence owns what a run over many frames needs beyond RefineFrame (refine.h): the
+// reference colours, computed once from the reference frame, saved with the recipe they were made
+// with and checked on every reuse; resume (a done frame is skipped, so a killed run, a second shard
+// or the same command again finishes the sequence); warm start (each frame seeded from the previous
+// frame's saved displacement, as solved: see SolvedDisplacement); the next frame read on a thread
+// of its own while this one is solved; the held-out cameras' score, with keep_input_if_worse; and
+// the errors against the capture's ground truth when it has any. It writes nothing but the run
+// folder's files and prints nothing: what a user should see is reported to a SequenceObserver.
+#ifndef FINECAP_SEQUENCE_H_
+#define FINECAP_SEQUENCE_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "finecap/capture.h"
+#include "finecap/frame_range.h"
+#include "finecap/frame_reader.h"
+#include "finecap/frame_stats.h"
+#include "finecap/heldout_score.h"
+#include "finecap/mesh_io.h"
+#include "finecap/problem_size.h"
+#include "finecap/refine.h"
+#include "finecap/run_folder.h"
+
+namespace finecap {
+
+struct SequenceOptions {
+  // How each frame is refined. Its lengths should be resolved from the scene first
+  // (ResolveSceneScaleDefaults, scene_scale.h).
+  RefineOptions refine;
+  // The frame whose images colour the surface Gaussians of every frame (model.reference_frame).
+  // Default 0.
+  int reference_frame = 0;
+  // Cameras that refinement never sees (not even for the reference colours): each frame's result
+  // and input are scored in them, and with refine.keep_input_if_worse a result that scores worse
+  // than its input is replaced by the input. Default none.
+  std::vector<std::string> held_out_cameras;
+  HeldOutOptions held_out_score;
+  // Refine a frame without a camera whose image cannot be read (reported to the observer) instead
+  // of failing. Default false.
+  bool skip_unreadable_cameras = false;
+  // How the refined meshes are written. Default PLY.
+  MeshFormat mesh_format = MeshFormat::kPly;
+
+  void Check() const;
+};
+
+// Everything the reference colours depend on (ComputeSequenceColors, and the held-out cameras it
+// must not see), as one line of `name=value` fields: two runs whose recipes are equal may share
+// one file of reference colours.
+std::string ReferenceColorRecipe(const SequenceOptions& options);
+
+// The reference colours saved at `path`, or, when there is no such file, those of the reference
+// frame, computed, saved there with their recipe and read back (so that a run uses exactly what a
+// later resumed run or shard reads). A saved file made with another recipe throws Error naming
+// `path` and the fields that differ (a file saved before recipes were is checked on its colour
+// space, sigma_hat and method). Cameras skipped in the reference frame go to *skipped (may be
+// null).
+ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
+                                             const SequenceOptions& options, Capture* capture,
+                                             const std::string& path,
+                                             std::vector<SkippedCamera>* skipped = nullptr);
+
+// The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
+// vector when the capture has no true surface for the frame.
+Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
+                                     const Mesh& coarse, int frame);
+
+// Where a done frame's solve ended, per fine vertex (SolvedDisplacement of its saved
+// displacement, kept_input read from its record): what seeds the next frame with warm start.
+Eigen::VectorXd ReadSolvedDisplacement(const FrameFiles& files, int num_fine_vertices,
+                                       const RefineOptions& options);
+
+// What RefineSequence tells its caller while it runs; every method does nothing unless
+// overridden. Called on the caller's thread.
+class SequenceObserver {
+ public:
+  virtual ~SequenceObserver() = default;
+  // Temporaries that a killed run left in the run folder were removed, before anything else.
+  virtual void StaleFilesRemoved(int /*count*/) {}
+  // Before the first frame: the frames to run (done ones included), the first frame's input as
+  // refinement sees it and the size of its problem.
+  virtual void Starting(int /*num_frames*/, const FrameInput& /*first*/,
+                        const ProblemSize& /*size*/) {}
+  // A camera's image of `frame` could not be read and the frame goes on without it
+  // (skip_unreadable_cameras).
+  virtual void CameraSkipped(const std::string& /*frame*/, const SkippedCamera& /*camera*/) {}
+  // No camera sees any vertex to refine in `frame`: its input surface is written.
+  virtual void NothingToRefine(const std::string& /*frame*/) {}
+  // A frame was found done in the run folder and skipped.
+  virtual void FrameAlreadyDone(const std::string& /*frame*/) {}
+  // A frame was refined and its files written; `stats` is its record.
+  virtual void FrameRefined(const FrameStats& /*stats*/) {}
+};
+
+struct SequenceResult {
+  int refined = 0;       // Frames refined by this call.
+  int already_done = 0;  // Frames found done and skipped.
+  // Over the frames refined now that have ground truth (`measured` of them): the root mean square
+  // of their per-frame RMS errors (textured region), input and refined, millimetres; NaN when none.
+  int measured = 0;
+  double rms_coarse_mm = 0.0;
+  double rms_refined_mm = 0.0;
+};
+
+// Refines frames [frames.begin, frames.end) of `capture` into the run folder `out`, which must
+// exist (its subfolders are created); frames already done there are skipped. The topology and the
+// refined vertices are those of frame 0. Several processes may run on one folder at once with
+// disjoint frames (shards). Throws Error (options.Check(), unreadable input, a reference colour
+// file of another recipe) before a frame's files are written, never leaving one half-written.
+// `observer` may be null.
+SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
+                              const SequenceOptions& options, const std::string& out,
+                              SequenceObserver* observer = nullptr);
+
+}  // namespace finecap
+
+#endif  // FINECAP_SEQUENCE_H_

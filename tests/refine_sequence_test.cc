@@ -1,0 +1,174 @@
+// A sequence refined frame after frame (sequence.h): how one frame's result seeds the next (warm
+// start) when bias compensation and kept inputs are involved, the reference colours' recipe, what
+// the observer hears.
+#include "finecap/sequence.h"
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "finecap/atomic_file.h"
+#include "finecap/commands.h"
+#include "finecap/config.h"
+#include "finecap/error.h"
+#include "finecap/frame_stats.h"
+#include "finecap/synth.h"
+#include "test_util.h"
+#include "tiny_synth.h"
+
+namespace finecap {
+namespace {
+
+namespace fs = std::filesystem;
+using testing_util::ExpectErrorMentions;
+using testing_util::FileBytes;
+using testing_util::MakeTempDir;
+using testing_util::OneWorkerThread;
+
+FrameStats Record(const std::string& out, const std::string& frame) {
+  return ReadFrameStats(FrameFilesIn(out, frame, MeshFormat::kPly).stats);
+}
+
+// A frame whose input was kept has, as solved, displacement 0: the frame after it starts there,
+// as a frame without a predecessor does, and not at -sigma_hat (its saved 0 with the bias
+// compensation taken off as if it had been added).
+TEST(RefineSequenceTest, TheFrameAfterAKeptInputStartsWhereAFirstFrameStarts) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_after_kept");
+  const std::string capture = root + "/capture";
+  // No folds: the input is the true surface, so the 4 cm the bias compensation of wide Gaussians
+  // adds without an iteration makes frame 0 worse in the held-out camera, and its input is kept.
+  SynthOptions options = testing_util::TinyRefinableSynthOptions(2);
+  options.cameras.count = 6;
+  options.folds.clear();
+  GenerateSyntheticCapture(options, capture);
+  Config config = testing_util::TinyRunConfig(capture, root + "/sequence", 0);
+  config.eval.flow = "none";
+  config.validation.cameras = {"cam05"};
+  config.refine.sigma_hat = 0.04;
+  config.refine.scene_lengths.sigma_hat = false;
+  config.refine.bias_compensation = true;
+  config.refine.keep_input_if_worse = true;
+  config.refine.warm_start = true;
+  config.refine.sweep.samples = 0;  // A frame without a predecessor starts at zero.
+  ASSERT_EQ(RunRefine(config), 0);
+  ASSERT_TRUE(Record(config.output.dir, "000000").kept_input);
+
+  Config alone = config;
+  alone.output.dir = root + "/alone";
+  alone.capture.frames = "1:2";
+  ASSERT_EQ(RunRefine(alone), 0);
+  const FrameStats after_kept = Record(config.output.dir, "000001");
+  const FrameStats first = Record(alone.output.dir, "000001");
+  ASSERT_TRUE(std::isfinite(first.energy_start));
+  EXPECT_EQ(after_kept.energy_start, first.energy_start);
+  EXPECT_EQ(after_kept.kept_input, first.kept_input);
+}
+
+// Counts what RefineSequence reports.
+class CountingObserver : public SequenceObserver {
+ public:
+  void Starting(int num_frames, const FrameInput& first, const ProblemSize& size) override {
+    started_frames = num_frames;
+    first_cameras = static_cast<int>(first.cameras.size());
+    surface_gaussians = size.num_surface_gaussians;
+  }
+  void FrameAlreadyDone(const std::string&) override { ++already_done; }
+  void FrameRefined(const FrameStats& stats) override { refined.push_back(stats.frame); }
+
+  int started_frames = 0, first_cameras = 0, already_done = 0;
+  long surface_gaussians = 0;
+  std::vector<std::string> refined;
+};
+
+SequenceOptions QuickOptions() {
+  SequenceOptions options;
+  options.refine.solver.max_iterations = 2;
+  options.refine.solver.num_threads = 1;
+  options.refine.sweep.samples = 0;
+  return options;
+}
+
+TEST(RefineSequenceTest, RefinesTheFramesLeftAndReportsThem) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_library");
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), root + "/capture");
+  Capture capture = Capture::Open(root + "/capture");
+  SequenceOptions options = QuickOptions();
+  options.held_out_cameras = {"cam02"};
+  const std::string out = root + "/run";
+  fs::create_directories(out);
+
+  CountingObserver first_run;
+  const SequenceResult first = RefineSequence(&capture, {0, 1}, options, out, &first_run);
+  EXPECT_EQ(first.refined, 1);
+  EXPECT_EQ(first_run.started_frames, 1);
+  EXPECT_EQ(first_run.first_cameras, 2);  // The held-out camera is not refinement's.
+  EXPECT_GT(first_run.surface_gaussians, 0);
+  EXPECT_EQ(first_run.refined, std::vector<std::string>{"000000"});
+  EXPECT_TRUE(FrameDone(FrameFilesIn(out, "000000", MeshFormat::kPly)));
+  EXPECT_FALSE(FrameDone(FrameFilesIn(out, "000001", MeshFormat::kPly)));
+
+  CountingObserver second_run;
+  const SequenceResult second = RefineSequence(&capture, {0, 2}, options, out, &second_run);
+  EXPECT_EQ(second.already_done, 1);
+  EXPECT_EQ(second.refined, 1);
+  EXPECT_EQ(second_run.refined, std::vector<std::string>{"000001"});
+  EXPECT_TRUE(FrameDone(FrameFilesIn(out, "000001", MeshFormat::kPly)));
+  EXPECT_EQ(second.measured, 1);  // The synthetic capture has ground truth.
+  EXPECT_TRUE(std::isfinite(second.rms_refined_mm));
+
+  options.refine.sigma_hat = -1.0;
+  ExpectErrorMentions([&] { RefineSequence(&capture, {0, 2}, options, out); }, {"sigma_hat"});
+}
+
+// The reference colours are saved with what they were made of; a run that would make them
+// otherwise (here: another quad-tree depth, which the file's own fields do not show) is refused,
+// while a file saved before recipes were still resumes.
+TEST(RefineSequenceTest, ReferenceColoursOfAnotherRecipeAreRefused) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_recipe");
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), root + "/capture");
+  Capture capture = Capture::Open(root + "/capture");
+  const SequenceOptions options = QuickOptions();
+  const std::string out = root + "/run";
+  fs::create_directories(out);
+  RefineSequence(&capture, {0, 1}, options, out);
+  const std::string colors = FileBytes(ReferenceColorsPath(out));
+  EXPECT_NE(colors.find("recipe " + ReferenceColorRecipe(options) + "\n"), std::string::npos);
+
+  SequenceOptions deeper = options;
+  deeper.refine.image.max_depth = options.refine.image.max_depth - 1;
+  EXPECT_NE(ReferenceColorRecipe(deeper), ReferenceColorRecipe(options));
+  ExpectErrorMentions(
+      [&] {
+        RefineSequence(&capture, {1, 2}, deeper, out);
+      },
+      {"reference_colors.txt", "max_depth=8", "max_depth=7"});
+  EXPECT_FALSE(FrameDone(FrameFilesIn(out, "000001", MeshFormat::kPly)));
+  SequenceOptions held_out = options;
+  held_out.held_out_cameras = {"cam01"};
+  ExpectErrorMentions(
+      [&] {
+        RefineSequence(&capture, {1, 2}, held_out, out);
+      },
+      {"reference_colors.txt", "held_out="});
+
+  // A file of an older version, without its recipe: checked on what it holds, and reused.
+  const size_t recipe = colors.find("recipe ");
+  WriteTextFileAtomically(ReferenceColorsPath(out),
+                          colors.substr(0, recipe) + colors.substr(colors.find('\n', recipe) + 1));
+  EXPECT_EQ(RefineSequence(&capture, {1, 2}, deeper, out).refined, 1);
+  SequenceOptions wider = options;
+  wider.refine.sigma_hat = 2.0 * options.refine.sigma_hat;
+  ExpectErrorMentions(
+      [&] {
+        RefineSequence(&capture, {0, 2}, wider, out);
+      },
+      {"reference_colors.txt", "sigma_hat"});
+}
+
+}  // namespace
+}  // namespace finecap
