@@ -56,7 +56,7 @@ const SkirtFrame& Skirt() {
 
 RefineOptions Options(const std::string& similarity) {
   RefineOptions options;
-  options.energy.similarity = similarity;
+  StringToEnum(similarity, &options.energy.similarity);
   return options;
 }
 

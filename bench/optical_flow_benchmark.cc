@@ -29,7 +29,7 @@ void RunFlow(benchmark::State& state, const OpticalFlowOptions& options) {
 
 void BM_DisFlow(benchmark::State& state, const std::string& preset) {
   OpticalFlowOptions options;
-  options.dis_preset = preset;
+  StringToEnum(preset, &options.dis_preset);
   RunFlow(state, options);
 }
 BENCHMARK_CAPTURE(BM_DisFlow, ultrafast, "ultrafast")->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -38,7 +38,7 @@ BENCHMARK_CAPTURE(BM_DisFlow, medium, "medium")->Unit(benchmark::kMillisecond)->
 
 void BM_DeepFlow(benchmark::State& state) {
   OpticalFlowOptions options;
-  options.method = "deepflow";
+  options.method = FlowMethod::kDeepFlow;
   RunFlow(state, options);
 }
 BENCHMARK(BM_DeepFlow)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);

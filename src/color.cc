@@ -133,27 +133,22 @@ cv::Mat ConvertUnchecked(const cv::Mat& bgr, ColorSpace space) {
 
 }  // namespace
 
-std::string ColorSpaceName(ColorSpace space) {
-  switch (space) {
-    case ColorSpace::kHsv:
-      return "hsv";
-    case ColorSpace::kNormalizedRgb:
-      return "normalized_rgb";
-    case ColorSpace::kLab:
-      return "lab";
-    case ColorSpace::kChromaticity:
-      return "chromaticity";
-  }
-  throw Error("", "unknown colour space");
+const std::vector<EnumName<ColorSpace>>& EnumNames(ColorSpace) {
+  static const std::vector<EnumName<ColorSpace>> names = {
+      {ColorSpace::kHsv, "hsv"},
+      {ColorSpace::kNormalizedRgb, "normalized_rgb"},
+      {ColorSpace::kLab, "lab"},
+      {ColorSpace::kChromaticity, "chromaticity"}};
+  return names;
 }
 
+std::string ColorSpaceName(ColorSpace space) { return EnumToString(space); }
+
 ColorSpace ParseColorSpace(const std::string& name, const std::string& where) {
-  for (ColorSpace space : {ColorSpace::kHsv, ColorSpace::kNormalizedRgb, ColorSpace::kLab,
-                           ColorSpace::kChromaticity}) {
-    if (name == ColorSpaceName(space)) return space;
-  }
-  throw Error(where, "unknown colour space '" + name +
-                         "'; expected hsv, normalized_rgb, lab or chromaticity");
+  ColorSpace space = ColorSpace::kHsv;
+  Require(StringToEnum(name, &space), where,
+          "unknown colour space '" + name + "'; expected hsv, normalized_rgb, lab or chromaticity");
+  return space;
 }
 
 Eigen::Vector3f ConvertColor(const cv::Vec3b& bgr, ColorSpace space) {

@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/error.h"
+#include "finecap/optical_flow.h"
 #include "finecap/scene_scale.h"
 
 namespace finecap {
@@ -81,6 +82,13 @@ void AddValidationKeys(ValidationConfig* validation, ConfigSchema* schema) {
                     0.01, 1000.0);
 }
 
+// eval.flow: a method of the optical flow, or none.
+std::vector<std::string> FlowChoices() {
+  std::vector<std::string> choices = EnumNameList<FlowMethod>();
+  choices.push_back("none");
+  return choices;
+}
+
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.dir", &config->capture.dir,
                     "Capture folder (cameras, images or videos, meshes; see the README).");
@@ -109,10 +117,9 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddChoice("eval.flow", &config->eval.flow,
                     "finecap eval: optical flow between the textured model's render and the "
                     "image (the paper's section 7): dis, deepflow (slower) or none.",
-                    {"dis", "deepflow", "none"});
+                    FlowChoices());
   schema->AddChoice("eval.flow_dis_preset", &config->eval.flow_dis_preset,
-                    "finecap eval: preset of the DIS optical flow.",
-                    {"ultrafast", "fast", "medium"});
+                    "finecap eval: preset of the DIS optical flow.", EnumNameList<DisPreset>());
   schema->AddChoice("eval.flow_cameras", &config->eval.flow_cameras,
                     "finecap eval: cameras the flow is measured in, pixels pooled: all, or "
                     "eval_camera (eval.camera only, as the paper's Figure 6).",
@@ -132,27 +139,21 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
       "model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
       "Standard deviation of every surface Gaussian, metres (paper: 0.007); " + SigmaHatAutoText(),
       1e-5, 1.0);
-  schema->AddChoice("model.reference_colors", &refine.reference_colors,
-                    "How the reference frame colours the surface Gaussians: pixels (the paper) or "
-                    "image_model (what the energy's image model shows in the best camera).",
-                    {"pixels", "image_model"});
+  schema->AddEnum("model.reference_colors", &refine.reference_colors,
+                  "How the reference frame colours the surface Gaussians: pixels (the paper) or "
+                  "image_model (what the energy's image model shows in the best camera).");
   schema->AddBool("model.bias_compensation", &refine.bias_compensation,
                   "Add sigma_hat along the normal after solving (the paper's shrink "
                   "compensation).");
-  schema->AddCustom(
-      "image_gaussians.color_space", "choice", "hsv, normalized_rgb, lab, chromaticity",
-      "Colour space in which colours are averaged and compared (paper: hsv).",
-      [&refine](const YAML::Node& value, const std::string& where) {
-        Require(value.IsScalar(), where, "expected one of: hsv, normalized_rgb, lab, chromaticity");
-        refine.image.color_space = ParseColorSpace(value.Scalar(), where);
-      },
-      [&refine] { return ColorSpaceName(refine.image.color_space); });
+  schema->AddEnum("image_gaussians.color_space", &refine.image.color_space,
+                  "Colour space in which colours are averaged and compared (paper: hsv).");
   schema->AddInt("image_gaussians.max_depth", &refine.image.max_depth,
                  "Quad-tree depth: leaves are min_leaf_size * 2^(max_depth - depth) pixels "
                  "(paper: 8).",
                  0, 16);
   schema->AddInt("image_gaussians.min_leaf_size", &refine.image.min_leaf_size,
-                 "Side of the smallest quad-tree leaf, pixels (its sigma is half of it).", 1, 1024);
+                 "Side of the smallest quad-tree leaf, pixels (its sigma is half of it).", 1,
+                 ImageGaussianOptions::kMaxMinLeafSize);
   schema->AddDouble("image_gaussians.split_threshold", &refine.image.split_threshold,
                     "A square is split while the RMS colour distance of its pixels to their "
                     "mean exceeds this.",
@@ -172,12 +173,11 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
 }
 
 void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSchema* schema) {
-  schema->AddChoice("energy.similarity", &energy->similarity,
-                    "paper: the paper's E_sim as printed; surface_color: each surface Gaussian's "
-                    "colour against the image around its projection (peaks at the truth); "
-                    "consensus: the cameras that see a patch agree on its normalised colours (no "
-                    "reference colours).",
-                    {"paper", "surface_color", "consensus"});
+  schema->AddEnum("energy.similarity", &energy->similarity,
+                  "paper: the paper's E_sim as printed; surface_color: each surface Gaussian's "
+                  "colour against the image around its projection (peaks at the truth); "
+                  "consensus: the cameras that see a patch agree on its normalised colours (no "
+                  "reference colours).");
   schema->AddDouble("energy.consensus.contrast_floor", &energy->consensus.contrast_floor,
                     "Consensus similarity: patches with less contrast than this (colour units) "
                     "are not normalised to unit variance.",
@@ -200,10 +200,9 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                     "Consensus similarity: scale of Cauchy's loss on each patch's disagreement, "
                     "as a fraction of that of unrelated patches; 0: plain least squares.",
                     0.0, 100.0);
-  schema->AddChoice("energy.overlap", &energy->overlap,
-                    "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
-                    "patch (image Gaussians as the squares they stand for).",
-                    {"printed", "exact", "patch"});
+  schema->AddEnum("energy.overlap", &energy->overlap,
+                  "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
+                  "patch (image Gaussians as the squares they stand for).");
   schema->AddDouble("energy.color_cutoff", &energy->color_cutoff,
                     "Wendland cut-off D of the colour weight of the paper's E_sim (paper: 0.05).",
                     1e-6, 10.0);
@@ -235,25 +234,22 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
   schema->AddInt("energy.reg_rings", &energy->reg_rings,
                  "Regulariser neighbourhood Delta in edges, also its Wendland cut-off (paper: 2).",
                  1, 10);
-  schema->AddChoice("energy.reg_unit", &energy->reg_unit,
-                    "Unit of k inside E_reg (the paper's lengths are millimetres).", {"mm", "m"});
+  schema->AddEnum("energy.reg_unit", &energy->reg_unit,
+                  "Unit of k inside E_reg (the paper's lengths are millimetres).");
 }
 
 void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* schema) {
-  schema->AddChoice("solver.type", &solver->type,
-                    "ceres (least squares, Levenberg-Marquardt), gradient_ascent (the paper's) "
-                    "or lbfgs.",
-                    {"ceres", "gradient_ascent", "lbfgs"});
+  schema->AddEnum("solver.type", &solver->type,
+                  "ceres (least squares, Levenberg-Marquardt), gradient_ascent (the paper's) "
+                  "or lbfgs.");
   schema->AddInt("solver.max_iterations", &solver->max_iterations,
                  "Most iterations per frame (the paper's ascent: 150).", 0, 100000);
   schema->AddDouble("solver.function_tolerance", &solver->function_tolerance,
                     "Stop when the energy changes by less than this fraction.", 0.0, 1.0);
-  schema->AddChoice("solver.trust_region", &solver->trust_region, "Ceres' trust-region strategy.",
-                    {"levenberg_marquardt", "dogleg"});
-  schema->AddChoice("solver.linear_solver", &solver->linear_solver,
-                    "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on "
-                    "the normal equations, or dense QR (tiny problems only).",
-                    {"sparse_normal_cholesky", "cgnr", "dense_qr"});
+  schema->AddEnum("solver.trust_region", &solver->trust_region, "Ceres' trust-region strategy.");
+  schema->AddEnum("solver.linear_solver", &solver->linear_solver,
+                  "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on "
+                  "the normal equations, or dense QR (tiny problems only).");
   schema->AddDoubleOrAuto("solver.initial_step", &solver->initial_step,
                           &refine->scene_lengths.initial_step,
                           "Gradient ascent: first step of the steepest k_s, m; " +
@@ -269,13 +265,6 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                           "Gradient ascent: largest step of one k_s in one iteration, m; " +
                               AutoText(SceneLengthFactors().max_step),
                           1e-9, 1.0);
-  schema->AddInt("solver.sweep_samples", &refine->sweep.samples,
-                 "Plane-sweep start: displacements tried per surface Gaussian before solving "
-                 "(0 = off, start at k = 0).",
-                 0, 1000);
-  schema->AddInt("solver.sweep_smoothing_rounds", &refine->sweep.smoothing_rounds,
-                 "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0,
-                 1000);
   schema->AddBool("refine.keep_input_if_worse", &refine->keep_input_if_worse,
                   "Write the input surface for a frame whose energy, or held-out NCC, got worse "
                   "(always flagged).");
@@ -289,9 +278,74 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
                     "Factor of sigma_hat and of the smallest quad-tree leaf from one level to the "
                     "next coarser.",
                     1.0001, 4.0);
+  schema->AddIntOrOff("refine.sweep.samples", &refine->sweep.samples,
+                      "Plane-sweep start: displacements tried per surface Gaussian before solving "
+                      "(0 = off, start at k = 0).",
+                      SweepOptions::kMinSamples, SweepOptions::kMaxSamples);
+  schema->AddInt("refine.sweep.smoothing_rounds", &refine->sweep.smoothing_rounds,
+                 "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0,
+                 1000);
+  schema->AddAlias("solver.sweep_samples", "refine.sweep.samples");
+  schema->AddAlias("solver.sweep_smoothing_rounds", "refine.sweep.smoothing_rounds");
+}
+
+// The config section of the fields of each options struct, so that a Check() failure naming a
+// field ("EnergyOptions::w_reg") is reported at its key ("energy.w_reg"): the sections follow the
+// structs, and RefineOptions' own fields are split between `model` and `refine`.
+const std::vector<std::pair<std::string, std::vector<std::string>>>& FieldSections() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> sections = {
+      {"RefineOptions::", {"model.", "refine."}},
+      {"ImageGaussianOptions::", {"image_gaussians."}},
+      {"VisibilityOptions::", {"visibility."}},
+      {"EnergyOptions::", {"energy."}},
+      {"ConsensusOptions::", {"energy.consensus."}},
+      {"SolverOptions::", {"solver."}},
+      {"SweepOptions::", {"refine.sweep."}},
+      {"CoarseToFineOptions::", {"refine.coarse_to_fine."}},
+      {"HeldOutOptions::", {"validation."}},
+      {"SynthOptions::", {"synth."}},
+      {"SkirtOptions::", {"synth.skirt."}},
+      {"TextureOptions::", {"synth.texture."}},
+      {"RigOptions::", {"synth.cameras."}},
+      {"RenderOptions::", {"synth.render."}}};
+  return sections;
+}
+
+// Whether `path` is a key of `schema` or a part of one ("synth.folds[1].profile" of
+// "synth.folds").
+bool IsKeyOrPart(const std::string& path, const ConfigSchema& schema) {
+  for (std::string key = path;;) {
+    if (schema.Has(key)) return true;
+    const size_t cut = key.find_last_of(".[");
+    if (cut == std::string::npos || cut == 0) return false;
+    key.resize(cut);
+  }
 }
 
 }  // namespace
+
+std::string ConfigKeyOfField(const std::string& field) {
+  Config defaults;
+  const ConfigSchema schema = MakeConfigSchema(&defaults);
+  for (const auto& [prefix, sections] : FieldSections()) {
+    if (field.rfind(prefix, 0) != 0) continue;
+    for (const std::string& section : sections) {
+      const std::string path = section + field.substr(prefix.size());
+      if (IsKeyOrPart(path, schema)) return path;
+    }
+  }
+  return "";
+}
+
+void CheckConfig(const Config& config, const std::string& source) {
+  try {
+    config.Check();
+  } catch (const Error& error) {
+    const std::string key = ConfigKeyOfField(error.where());
+    if (key.empty()) throw Error(source, error.what());
+    throw Error(source + ": key '" + key + "'", error.problem());
+  }
+}
 
 void Config::Check() const {
   frame_range();
@@ -320,11 +374,7 @@ Config LoadConfig(const std::string& file, const std::vector<ConfigOverride>& ov
     schema.Set(override_value.key, override_value.value, override_value.source);
   }
   config.refine.solver.num_threads = config.runtime.threads;
-  try {
-    config.Check();
-  } catch (const Error& error) {
-    throw Error(file.empty() ? "config" : file, error.what());
-  }
+  CheckConfig(config, file.empty() ? "config" : file);
   return config;
 }
 

@@ -133,11 +133,7 @@ Config VariantConfig(const Config& base, const CompareVariant& variant) {
   ConfigSchema schema = MakeConfigSchema(&config);
   ApplySettings(variant, &schema);
   config.refine.solver.num_threads = config.runtime.threads;
-  try {
-    config.Check();
-  } catch (const Error& error) {
-    throw Error(variant.source, error.what());
-  }
+  CheckConfig(config, variant.source);
   return config;
 }
 

@@ -81,6 +81,29 @@ std::string DoubleListText(const std::vector<double>& values) {
 
 }  // namespace
 
+ConfigSchema::Key ConfigSchema::MakeKey(
+    const std::string& path, const std::string& type, const std::string& range,
+    const std::string& doc,
+    std::function<void(const YAML::Node& value, const std::string& where)> assign,
+    std::function<std::string()> current_text) {
+  Key key;
+  key.path = path;
+  key.type = type;
+  key.range = range;
+  key.doc = doc;
+  key.assign = std::move(assign);
+  key.current_text = std::move(current_text);
+  return key;
+}
+
+template <typename T>
+void ConfigSchema::SetNumeric(T min, T max, std::function<void(double)> write_unchecked, Key* key) {
+  key->is_numeric = true;
+  key->min = static_cast<double>(min);
+  key->max = static_cast<double>(max);
+  key->write_unchecked = std::move(write_unchecked);
+}
+
 void ConfigSchema::AddKey(Key key) {
   Require(Find(key.path) == nullptr, key.path, "config key registered twice");
   key.default_text = key.current_text();
@@ -98,83 +121,131 @@ bool ConfigSchema::Has(const std::string& path) const { return Find(path) != nul
 
 void ConfigSchema::AddInt(const std::string& path, int* field, const std::string& doc, int min,
                           int max) {
-  AddKey({path, "int", RangeText(min, max), doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            const int number = Convert<int>(value, where, "an integer");
-            RequireInRange(number, min, max, where);
-            *field = number;
-          },
-          [=] { return std::to_string(*field); }});
+  Key key = MakeKey(
+      path, "int", RangeText(min, max), doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        const int number = Convert<int>(value, where, "an integer");
+        RequireInRange(number, min, max, where);
+        *field = number;
+      },
+      [=] { return std::to_string(*field); });
+  SetNumeric(
+      min, max, [=](double value) { *field = static_cast<int>(value); }, &key);
+  AddKey(std::move(key));
+}
+
+void ConfigSchema::AddIntOrOff(const std::string& path, int* field, const std::string& doc, int min,
+                               int max) {
+  Key key = MakeKey(
+      path, "int", "0 or " + RangeText(min, max), doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        const int number = Convert<int>(value, where, "an integer");
+        Require(number == 0 || (number >= min && number <= max), where,
+                "value " + std::to_string(number) + " is neither 0 (off) nor in " +
+                    RangeText(min, max));
+        *field = number;
+      },
+      [=] { return std::to_string(*field); });
+  SetNumeric(
+      min, max, [=](double value) { *field = static_cast<int>(value); }, &key);
+  key.zero_also = true;
+  AddKey(std::move(key));
 }
 
 void ConfigSchema::AddDouble(const std::string& path, double* field, const std::string& doc,
                              double min, double max) {
-  AddKey({path, "float", RangeText(min, max), doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            const double number = ConvertDouble(value, where);
-            RequireInRange(number, min, max, where);
-            *field = number;
-          },
-          [=] { return DoubleText(*field); }});
+  Key key = MakeKey(
+      path, "float", RangeText(min, max), doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        const double number = ConvertDouble(value, where);
+        RequireInRange(number, min, max, where);
+        *field = number;
+      },
+      [=] { return DoubleText(*field); });
+  SetNumeric(
+      min, max, [=](double value) { *field = value; }, &key);
+  AddKey(std::move(key));
 }
 
 void ConfigSchema::AddDoubleOrAuto(const std::string& path, double* field, bool* is_auto,
                                    const std::string& doc, double min, double max) {
-  AddKey({path, "float", RangeText(min, max) + " or auto", doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            if (value.IsScalar() && value.Scalar() == "auto") {
-              *is_auto = true;
-              return;
-            }
-            const double number = Convert<double>(value, where, "a number or auto");
-            Require(std::isfinite(number), where, "value must be finite");
-            RequireInRange(number, min, max, where);
-            *field = number;
-            *is_auto = false;
-          },
-          [=] { return *is_auto ? std::string("auto") : DoubleText(*field); }});
+  Key key = MakeKey(
+      path, "float", RangeText(min, max) + " or auto", doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        if (value.IsScalar() && value.Scalar() == "auto") {
+          *is_auto = true;
+          return;
+        }
+        const double number = Convert<double>(value, where, "a number or auto");
+        Require(std::isfinite(number), where, "value must be finite");
+        RequireInRange(number, min, max, where);
+        *field = number;
+        *is_auto = false;
+      },
+      [=] { return *is_auto ? std::string("auto") : DoubleText(*field); });
+  SetNumeric(
+      min, max,
+      [=](double value) {
+        *field = value;
+        *is_auto = false;
+      },
+      &key);
+  AddKey(std::move(key));
 }
 
 void ConfigSchema::AddBool(const std::string& path, bool* field, const std::string& doc) {
-  AddKey({path, "bool", "true, false", doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            *field = Convert<bool>(value, where, "true or false");
-          },
-          [=] { return std::string(*field ? "true" : "false"); }});
+  AddKey(MakeKey(
+      path, "bool", "true, false", doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        *field = Convert<bool>(value, where, "true or false");
+      },
+      [=] { return std::string(*field ? "true" : "false"); }));
 }
 
 void ConfigSchema::AddString(const std::string& path, std::string* field, const std::string& doc) {
-  AddKey({path, "string", "", doc, "",
-          [=](const YAML::Node& value, const std::string& where) { *field = Scalar(value, where); },
-          [=] { return *field; }});
+  AddKey(MakeKey(
+      path, "string", "", doc,
+      [=](const YAML::Node& value, const std::string& where) { *field = Scalar(value, where); },
+      [=] { return *field; }));
+}
+
+void ConfigSchema::AddChoiceKey(const std::string& path, const std::string& doc,
+                                const std::vector<std::string>& choices,
+                                std::function<void(const std::string&)> set,
+                                std::function<std::string()> current_text) {
+  AddKey(MakeKey(
+      path, "choice", Join(choices, ", "), doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        const std::string text = Scalar(value, where);
+        bool known = false;
+        for (const std::string& choice : choices) known = known || choice == text;
+        Require(known, where, "'" + text + "' is not one of: " + Join(choices, ", "));
+        set(text);
+      },
+      std::move(current_text)));
 }
 
 void ConfigSchema::AddChoice(const std::string& path, std::string* field, const std::string& doc,
                              const std::vector<std::string>& choices) {
-  AddKey({path, "choice", Join(choices, ", "), doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            const std::string text = Scalar(value, where);
-            bool known = false;
-            for (const std::string& choice : choices) known = known || choice == text;
-            Require(known, where, "'" + text + "' is not one of: " + Join(choices, ", "));
-            *field = text;
-          },
-          [=] { return *field; }});
+  AddChoiceKey(
+      path, doc, choices, [field](const std::string& text) { *field = text; },
+      [field] { return *field; });
 }
 
 void ConfigSchema::AddDoubleList(const std::string& path, std::vector<double>* field,
                                  const std::string& doc, double min, double max) {
-  AddKey({path, "list of float", RangeText(min, max), doc, "",
-          [=](const YAML::Node& value, const std::string& where) {
-            Require(value.IsSequence(), where, "expected a list such as [1, 2]");
-            std::vector<double> numbers;
-            for (const YAML::Node& item : value) {
-              numbers.push_back(ConvertDouble(item, where));
-              RequireInRange(numbers.back(), min, max, where);
-            }
-            *field = numbers;
-          },
-          [=] { return DoubleListText(*field); }});
+  AddKey(MakeKey(
+      path, "list of float", RangeText(min, max), doc,
+      [=](const YAML::Node& value, const std::string& where) {
+        Require(value.IsSequence(), where, "expected a list such as [1, 2]");
+        std::vector<double> numbers;
+        for (const YAML::Node& item : value) {
+          numbers.push_back(ConvertDouble(item, where));
+          RequireInRange(numbers.back(), min, max, where);
+        }
+        *field = numbers;
+      },
+      [=] { return DoubleListText(*field); }));
 }
 
 void ConfigSchema::AddCustom(
@@ -182,7 +253,28 @@ void ConfigSchema::AddCustom(
     const std::string& doc,
     std::function<void(const YAML::Node& value, const std::string& where)> assign,
     std::function<std::string()> current_text) {
-  AddKey({path, type, range, doc, "", std::move(assign), std::move(current_text)});
+  AddKey(MakeKey(path, type, range, doc, std::move(assign), std::move(current_text)));
+}
+
+void ConfigSchema::AddAlias(const std::string& old_path, const std::string& path) {
+  const Key* target = Find(path);
+  Require(target != nullptr, old_path, "an alias of a key that is not registered");
+  Key alias = *target;
+  alias.path = old_path;
+  alias.doc = "Former name of `" + path + "`, still accepted.";
+  alias.alias_of = path;
+  alias.is_numeric = false;
+  AddKey(std::move(alias));
+}
+
+std::vector<ConfigSchema::NumericKey> ConfigSchema::NumericKeys() const {
+  std::vector<NumericKey> numeric;
+  for (const Key& key : keys_) {
+    if (!key.is_numeric) continue;
+    numeric.push_back(
+        {key.path, key.type == "int", key.min, key.max, key.zero_also, key.write_unchecked});
+  }
+  return numeric;
 }
 
 void ConfigSchema::ReadFile(const std::string& file) {

@@ -141,13 +141,12 @@ const FoldNumber kFoldNumbers[] = {
     {"phase", &FoldComponent::phase, kNoMin, kNoMax},
     {"drift", &FoldComponent::drift, kNoMin, kNoMax},
 };
-const std::vector<std::string> kFoldProfiles = {"sine", "ridge"};
 const char kFoldKeys[] = "amplitude, wavelength, orientation, phase, drift, profile";
 
 void ParseFoldField(const std::string& name, const YAML::Node& value, const std::string& where,
                     FoldComponent* fold) {
   if (name == "profile") {
-    fold->profile = ParseChoice(value, where, kFoldProfiles);
+    StringToEnum(ParseChoice(value, where, EnumNameList<FoldProfile>()), &fold->profile);
     return;
   }
   for (const FoldNumber& number : kFoldNumbers) {
@@ -189,7 +188,7 @@ std::string FoldsText(const std::vector<FoldComponent>& folds) {
     for (const FoldNumber& number : kFoldNumbers) {
       text += std::string(number.name) + ": " + NumberText(folds[i].*number.field) + ", ";
     }
-    text += "profile: " + folds[i].profile + "}";
+    text += "profile: " + EnumToString(folds[i].profile) + "}";
   }
   return text + "]";
 }
@@ -207,22 +206,10 @@ void AddFoldsKey(std::vector<FoldComponent>* folds, ConfigSchema* schema) {
 
 // ---- Coarse input ----
 
-const char* CoarseInputName(CoarseInput coarse) {
-  return coarse == CoarseInput::kSmoothed ? "smoothed" : "unfolded";
-}
-
 void AddCoarseInputKeys(SynthOptions* synth, ConfigSchema* schema) {
-  const std::vector<std::string> choices = {"unfolded", "smoothed"};
-  CoarseInput* coarse = &synth->coarse;
-  schema->AddCustom(
-      "synth.coarse", "choice", "unfolded, smoothed",
-      "The coarse meshes: unfolded (the true surface without its folds) or smoothed (the true "
-      "surface Taubin-smoothed, synth.smoothing).",
-      [coarse, choices](const YAML::Node& value, const std::string& where) {
-        *coarse = ParseChoice(value, where, choices) == "smoothed" ? CoarseInput::kSmoothed
-                                                                   : CoarseInput::kUnfolded;
-      },
-      [coarse] { return std::string(CoarseInputName(*coarse)); });
+  schema->AddEnum("synth.coarse", &synth->coarse,
+                  "The coarse meshes: unfolded (the true surface without its folds) or smoothed "
+                  "(the true surface Taubin-smoothed, synth.smoothing).");
   TaubinSmoothingOptions& smoothing = synth->smoothing;
   schema->AddInt("synth.smoothing.iterations", &smoothing.iterations,
                  "synth.coarse smoothed: Taubin iterations (lambda and mu step each), the "
@@ -297,9 +284,8 @@ void AddTextureKeys(TextureOptions* texture, ConfigSchema* schema) {
                  16384);
   schema->AddInt("synth.texture.height", &texture->height, "Texture height, texels (down).", 16,
                  16384);
-  schema->AddChoice("synth.texture.pattern", &texture->pattern,
-                    "Cloth print: plaid, motifs and noise mixed, or one of them alone.",
-                    {"mixed", "plaid", "stripes", "print", "noise"});
+  schema->AddEnum("synth.texture.pattern", &texture->pattern,
+                  "Cloth print: plaid, motifs and noise mixed, or one of them alone.");
   schema->AddDouble("synth.texture.textureless_begin", &texture->textureless_begin,
                     "Start of the plain band, fraction of the height from the top.", 0.0, 1.0);
   schema->AddDouble("synth.texture.textureless_end", &texture->textureless_end,
@@ -357,10 +343,9 @@ void AddRenderKeys(RenderOptions* render, ConfigSchema* schema) {
 }  // namespace
 
 void AddSynthKeys(SynthOptions* options, ConfigSchema* schema) {
-  schema->AddChoice("synth.subject", &options->subject,
-                    "skirt: the built-in flared tube (synth.skirt); mesh: the meshes at "
-                    "synth.mesh_path.",
-                    {"skirt", "mesh"});
+  schema->AddEnum("synth.subject", &options->subject,
+                  "skirt: the built-in flared tube (synth.skirt); mesh: the meshes at "
+                  "synth.mesh_path.");
   AddSkirtKeys(&options->skirt, schema);
   AddGeometryKeys(options, schema);
   AddCoarseInputKeys(options, schema);

@@ -14,7 +14,8 @@ PairOptions EnergyPairOptions(const EnergyOptions& options) {
   pair_options.reach_sigmas = options.reach_sigmas;
   // The paper's similarity weighs pairs by colour agreement; the colour residual compares
   // colours itself and needs every pair in reach.
-  pair_options.color_cutoff = options.similarity == "paper" ? options.color_cutoff : 0.0;
+  pair_options.color_cutoff =
+      options.similarity == SimilarityType::kPaper ? options.color_cutoff : 0.0;
   return pair_options;
 }
 
@@ -62,9 +63,10 @@ std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
                                                const std::vector<EnergyView>& views,
                                                const VertexNeighbourhoods& neighbourhoods,
                                                const EnergyOptions& options) {
-  const OverlapForm form = ParseOverlapForm(options.overlap);
-  if (options.similarity == "paper") return std::make_unique<PaperSimilarity>(surface, views, form);
-  if (options.similarity == "consensus") {
+  const OverlapForm form = options.overlap;
+  if (options.similarity == SimilarityType::kPaper)
+    return std::make_unique<PaperSimilarity>(surface, views, form);
+  if (options.similarity == SimilarityType::kConsensus) {
     return std::make_unique<ConsensusSimilarity>(
         surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form,
         options.k_max, options.consensus);

@@ -27,8 +27,8 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   FrameStats stats;
   const SolverSummary& summary = result.summary;
   stats.frame = frame;
-  stats.solver = options.solver.type;
-  stats.similarity = options.energy.similarity;
+  stats.solver = EnumToString(options.solver.type);
+  stats.similarity = EnumToString(options.energy.similarity);
   stats.energy_start = summary.energy_start;
   stats.energy_end = summary.energy_end;
   stats.ls_cost_start = summary.ls_cost_start;

@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "finecap/error.h"
+#include "option_checks.h"
 
 namespace finecap {
 namespace {
@@ -14,7 +15,7 @@ namespace {
 // Spread^2 below this counts as zero: the rounding error of the pyramid's sums is far smaller,
 // and the smallest real spread of 8-bit colours (one grey level in 2^20 pixels) far larger.
 constexpr double kSpreadSquaredTolerance = 1e-13;
-constexpr int kMaxRootSide = 1 << 20;
+constexpr int kMaxRootSide = ImageGaussianOptions::kMaxRootSide;
 
 // Sums over the foreground pixels of one quad-tree square.
 struct Moments {
@@ -188,15 +189,18 @@ int SizeExponent(float sigma) {
 
 void ImageGaussianOptions::Check() const {
   const std::string where = "ImageGaussianOptions";
+  internal::RequireKnownChoice(color_space, where + "::color_space");
   Require(max_depth >= 0 && max_depth <= 16, where + "::max_depth",
           "must be in [0, 16], got " + std::to_string(max_depth));
-  Require(min_leaf_size >= 1, where + "::min_leaf_size",
-          "must be at least 1, got " + std::to_string(min_leaf_size));
+  Require(min_leaf_size >= 1 && min_leaf_size <= kMaxMinLeafSize, where + "::min_leaf_size",
+          "must be in [1, " + std::to_string(kMaxMinLeafSize) + "], got " +
+              std::to_string(min_leaf_size));
   Require(min_leaf_size <= (kMaxRootSide >> max_depth), where + "::min_leaf_size",
           "min_leaf_size * 2^max_depth may not exceed 2^20, got " + std::to_string(min_leaf_size) +
               " * 2^" + std::to_string(max_depth));
-  Require(std::isfinite(split_threshold) && split_threshold >= 0.0, where + "::split_threshold",
-          "must be finite and non-negative, got " + std::to_string(split_threshold));
+  Require(std::isfinite(split_threshold) && split_threshold >= 0.0 && split_threshold <= 10.0,
+          where + "::split_threshold",
+          "must be in [0, 10], got " + std::to_string(split_threshold));
 }
 
 ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,

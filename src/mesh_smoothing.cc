@@ -89,7 +89,7 @@ void NormalLaplacianStep(const Eigen::SparseMatrix<double, Eigen::RowMajor>& wei
 }  // namespace
 
 Eigen::Matrix3Xd TaubinSmooth(const Mesh& mesh, const TaubinSmoothingOptions& options) {
-  options.Check("smoothing");
+  options.Check("TaubinSmoothingOptions");
   const Eigen::SparseMatrix<double, Eigen::RowMajor> weights = NeighbourWeights(mesh);
   // 1 for a vertex with neighbours (its row sums to 1), 0 for one in no triangle.
   Eigen::VectorXd has_neighbours = weights * Eigen::VectorXd::Ones(mesh.num_vertices());

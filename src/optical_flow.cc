@@ -8,13 +8,15 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "finecap/error.h"
+#include "option_checks.h"
 
 namespace finecap {
+
 namespace {
 
-int DisPreset(const std::string& name) {
-  if (name == "ultrafast") return cv::DISOpticalFlow::PRESET_ULTRAFAST;
-  if (name == "fast") return cv::DISOpticalFlow::PRESET_FAST;
+int OpenCvPreset(DisPreset preset) {
+  if (preset == DisPreset::kUltrafast) return cv::DISOpticalFlow::PRESET_ULTRAFAST;
+  if (preset == DisPreset::kFast) return cv::DISOpticalFlow::PRESET_FAST;
   return cv::DISOpticalFlow::PRESET_MEDIUM;
 }
 
@@ -35,11 +37,8 @@ void RequireFlowImage(const cv::Mat& image, const std::string& where, const std:
 }  // namespace
 
 void OpticalFlowOptions::Check() const {
-  Require(method == "dis" || method == "deepflow", "optical flow options.method",
-          "'" + method + "' is not one of: dis, deepflow");
-  Require(dis_preset == "ultrafast" || dis_preset == "fast" || dis_preset == "medium",
-          "optical flow options.dis_preset",
-          "'" + dis_preset + "' is not one of: ultrafast, fast, medium");
+  internal::RequireKnownChoice(method, "OpticalFlowOptions::method");
+  internal::RequireKnownChoice(dis_preset, "OpticalFlowOptions::dis_preset");
 }
 
 cv::Mat ComputeOpticalFlow(const cv::Mat& from, const cv::Mat& to,
@@ -49,9 +48,10 @@ cv::Mat ComputeOpticalFlow(const cv::Mat& from, const cv::Mat& to,
   RequireFlowImage(to, where, "the second");
   Require(from.size() == to.size(), where, "the two images differ in size");
   const cv::Ptr<cv::DenseOpticalFlow> method =
-      options.method == "deepflow" ? cv::optflow::createOptFlow_DeepFlow()
-                                   : cv::Ptr<cv::DenseOpticalFlow>(
-                                         cv::DISOpticalFlow::create(DisPreset(options.dis_preset)));
+      options.method == FlowMethod::kDeepFlow
+          ? cv::optflow::createOptFlow_DeepFlow()
+          : cv::Ptr<cv::DenseOpticalFlow>(
+                cv::DISOpticalFlow::create(OpenCvPreset(options.dis_preset)));
   cv::Mat flow;
   method->calc(Grey(from), Grey(to), flow);
   return flow;

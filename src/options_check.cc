@@ -1,23 +1,87 @@
 // The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h)
-// and of the held-out score (heldout_score.h):
+// and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
+// of the optical flow's (optical_flow.h), which the config's eval section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
+//
+// Each Check() names the C++ field it refuses; its ranges are the config schema's
+// (config_options_test walks the schema and holds them to it).
 #include "finecap/energy_options.h"
 #include "finecap/error.h"
 #include "finecap/gaussian_overlap.h"
 #include "finecap/heldout_score.h"
+#include "finecap/optical_flow.h"
 #include "finecap/refine.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
+#include "option_checks.h"
 
 namespace finecap {
 
+using internal::RequireFieldRange;
+using internal::RequireKnownChoice;
+
+const std::vector<EnumName<SimilarityType>>& EnumNames(SimilarityType) {
+  static const std::vector<EnumName<SimilarityType>> names = {
+      {SimilarityType::kPaper, "paper"},
+      {SimilarityType::kSurfaceColor, "surface_color"},
+      {SimilarityType::kConsensus, "consensus"}};
+  return names;
+}
+
+const std::vector<EnumName<RegUnit>>& EnumNames(RegUnit) {
+  static const std::vector<EnumName<RegUnit>> names = {{RegUnit::kMillimetres, "mm"},
+                                                       {RegUnit::kMetres, "m"}};
+  return names;
+}
+
+const std::vector<EnumName<SolverType>>& EnumNames(SolverType) {
+  static const std::vector<EnumName<SolverType>> names = {
+      {SolverType::kCeres, "ceres"},
+      {SolverType::kGradientAscent, "gradient_ascent"},
+      {SolverType::kLbfgs, "lbfgs"}};
+  return names;
+}
+
+const std::vector<EnumName<TrustRegionType>>& EnumNames(TrustRegionType) {
+  static const std::vector<EnumName<TrustRegionType>> names = {
+      {TrustRegionType::kLevenbergMarquardt, "levenberg_marquardt"},
+      {TrustRegionType::kDogleg, "dogleg"}};
+  return names;
+}
+
+const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType) {
+  static const std::vector<EnumName<LinearSolverType>> names = {
+      {LinearSolverType::kSparseNormalCholesky, "sparse_normal_cholesky"},
+      {LinearSolverType::kCgnr, "cgnr"},
+      {LinearSolverType::kDenseQr, "dense_qr"}};
+  return names;
+}
+
+const std::vector<EnumName<FlowMethod>>& EnumNames(FlowMethod) {
+  static const std::vector<EnumName<FlowMethod>> names = {{FlowMethod::kDis, "dis"},
+                                                          {FlowMethod::kDeepFlow, "deepflow"}};
+  return names;
+}
+
+const std::vector<EnumName<DisPreset>>& EnumNames(DisPreset) {
+  static const std::vector<EnumName<DisPreset>> names = {{DisPreset::kUltrafast, "ultrafast"},
+                                                         {DisPreset::kFast, "fast"},
+                                                         {DisPreset::kMedium, "medium"}};
+  return names;
+}
+
+const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSource) {
+  static const std::vector<EnumName<ReferenceColorSource>> names = {
+      {ReferenceColorSource::kPixels, "pixels"},
+      {ReferenceColorSource::kImageModel, "image_model"}};
+  return names;
+}
+
 void RefineOptions::Check() const {
-  Require(subdivision_levels >= 0 && subdivision_levels <= 4, "model.subdivision_levels",
-          "must lie in [0, 4]");
-  Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
-  Require(reference_colors == "pixels" || reference_colors == "image_model",
-          "model.reference_colors", "must be pixels or image_model");
+  RequireFieldRange(subdivision_levels, 0, 4, "RefineOptions::subdivision_levels");
+  RequireFieldRange(sigma_hat, 1e-5, 1.0, "RefineOptions::sigma_hat");
+  RequireKnownChoice(reference_colors, "RefineOptions::reference_colors");
   image.Check();
   visibility.Check();
   energy.Check();
@@ -27,64 +91,63 @@ void RefineOptions::Check() const {
 }
 
 void EnergyOptions::Check() const {
-  Require(similarity == "paper" || similarity == "surface_color" || similarity == "consensus",
-          "energy.similarity",
-          "'" + similarity + "' is not one of: paper, surface_color, consensus");
+  RequireKnownChoice(similarity, "EnergyOptions::similarity");
   consensus.Check();
-  ParseOverlapForm(overlap);
-  Require(color_cutoff > 0.0, "energy.color_cutoff", "must be positive");
-  Require(reach_sigmas > 0.0, "energy.reach_sigmas", "must be positive");
-  Require(k_max > 0.0, "energy.k_max", "must be positive");
-  Require(w_reg >= 0.0, "energy.w_reg", "must be non-negative");
-  Require(w_prior >= 0.0, "energy.w_prior", "must be non-negative");
-  Require(confidence_prior >= 0.0, "energy.confidence_prior", "must be non-negative");
-  Require(confidence_threshold > 0.0, "energy.confidence_threshold", "must be positive");
-  Require(confidence_opening >= 0, "energy.confidence_opening", "must be non-negative");
-  Require(reg_rings >= 1, "energy.reg_rings", "must be at least 1");
-  Require(reg_unit == "mm" || reg_unit == "m", "energy.reg_unit", "must be mm or m");
+  RequireKnownChoice(overlap, "EnergyOptions::overlap");
+  RequireFieldRange(color_cutoff, 1e-6, 10.0, "EnergyOptions::color_cutoff");
+  RequireFieldRange(reach_sigmas, 0.5, 10.0, "EnergyOptions::reach_sigmas");
+  RequireFieldRange(k_max, 1e-5, 1.0, "EnergyOptions::k_max");
+  RequireFieldRange(w_reg, 0.0, 1e12, "EnergyOptions::w_reg");
+  RequireFieldRange(w_prior, 0.0, 1e12, "EnergyOptions::w_prior");
+  RequireFieldRange(confidence_prior, 0.0, 1e6, "EnergyOptions::confidence_prior");
+  RequireFieldRange(confidence_threshold, 1e-9, 1e3, "EnergyOptions::confidence_threshold");
+  RequireFieldRange(confidence_opening, 0, 20, "EnergyOptions::confidence_opening");
+  RequireFieldRange(reg_rings, 1, 10, "EnergyOptions::reg_rings");
+  RequireKnownChoice(reg_unit, "EnergyOptions::reg_unit");
 }
 
 void ConsensusOptions::Check() const {
-  Require(contrast_floor > 0.0, "energy.consensus.contrast_floor", "must be positive");
-  Require(min_cameras >= 2, "energy.consensus.min_cameras", "must be at least 2");
-  Require(passes >= 1, "energy.consensus.passes", "must be at least 1");
-  Require(patch_rings >= 1, "energy.consensus.patch_rings", "must be at least 1");
-  Require(robust_fraction >= 0.0, "energy.consensus.robust_fraction", "must be non-negative");
+  RequireFieldRange(contrast_floor, 1e-6, 1.0, "ConsensusOptions::contrast_floor");
+  RequireFieldRange(min_cameras, 2, 64, "ConsensusOptions::min_cameras");
+  RequireFieldRange(passes, 1, 10, "ConsensusOptions::passes");
+  RequireFieldRange(patch_rings, 1, 4, "ConsensusOptions::patch_rings");
+  RequireFieldRange(robust_fraction, 0.0, 100.0, "ConsensusOptions::robust_fraction");
 }
 
 void SolverOptions::Check() const {
-  Require(type == "ceres" || type == "gradient_ascent" || type == "lbfgs", "solver.type",
-          "'" + type + "' is not one of: ceres, gradient_ascent, lbfgs");
-  Require(max_iterations >= 0, "solver.max_iterations", "must be non-negative");
-  Require(function_tolerance >= 0.0, "solver.function_tolerance", "must be non-negative");
-  Require(num_threads >= 0, "solver.num_threads", "must be non-negative");
-  Require(trust_region == "levenberg_marquardt" || trust_region == "dogleg", "solver.trust_region",
-          "'" + trust_region + "' is not one of: levenberg_marquardt, dogleg");
-  Require(linear_solver == "sparse_normal_cholesky" || linear_solver == "cgnr" ||
-              linear_solver == "dense_qr",
-          "solver.linear_solver",
-          "'" + linear_solver + "' is not one of: sparse_normal_cholesky, cgnr, dense_qr");
-  Require(initial_step > 0.0, "solver.initial_step", "must be positive");
-  Require(step_growth >= 1.0, "solver.step_growth", "must be at least 1");
-  Require(step_shrink > 0.0 && step_shrink < 1.0, "solver.step_shrink", "must lie in (0, 1)");
-  Require(max_step > 0.0, "solver.max_step", "must be positive");
+  RequireKnownChoice(type, "SolverOptions::type");
+  RequireFieldRange(max_iterations, 0, 100000, "SolverOptions::max_iterations");
+  RequireFieldRange(function_tolerance, 0.0, 1.0, "SolverOptions::function_tolerance");
+  Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
+  RequireKnownChoice(trust_region, "SolverOptions::trust_region");
+  RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
+  RequireFieldRange(initial_step, 1e-9, 1.0, "SolverOptions::initial_step");
+  RequireFieldRange(step_growth, 1.0, 10.0, "SolverOptions::step_growth");
+  RequireFieldRange(step_shrink, 1e-3, 0.999, "SolverOptions::step_shrink");
+  RequireFieldRange(max_step, 1e-9, 1.0, "SolverOptions::max_step");
 }
 
 void SweepOptions::Check() const {
-  Require(samples == 0 || samples >= 3, "solver.sweep_samples", "must be 0 (off) or at least 3");
-  Require(smoothing_rounds >= 0, "solver.sweep_smoothing_rounds", "must be non-negative");
+  // Fewer than 3 displacements would not include k = 0 and both signs.
+  Require(samples == 0 || (samples >= kMinSamples && samples <= kMaxSamples),
+          "SweepOptions::samples",
+          "is " + std::to_string(samples) + " but must be 0 (off) or lie in [" +
+              std::to_string(kMinSamples) + ", " + std::to_string(kMaxSamples) + "]");
+  RequireFieldRange(smoothing_rounds, 0, 1000, "SweepOptions::smoothing_rounds");
 }
 
 void CoarseToFineOptions::Check() const {
-  Require(levels >= 1 && levels <= 5, "refine.coarse_to_fine.levels", "must lie in [1, 5]");
-  Require(scale > 1.0 && scale <= 4.0, "refine.coarse_to_fine.scale", "must lie in (1, 4]");
+  RequireFieldRange(levels, 1, 5, "CoarseToFineOptions::levels");
+  RequireFieldRange(scale, 1.0001, 4.0, "CoarseToFineOptions::scale");
 }
 
 void HeldOutOptions::Check() const {
-  Require(neighbours >= 1, "validation.neighbours", "must be at least 1");
-  Require(window >= 3 && window % 2 == 1, "validation.window", "must be an odd number >= 3");
-  Require(min_std >= 0.0, "validation.min_std", "must be non-negative");
-  Require(depth_tolerance_px > 0.0, "validation.depth_tolerance_px", "must be positive");
+  RequireFieldRange(neighbours, 1, 1000, "HeldOutOptions::neighbours");
+  RequireFieldRange(window, 3, 31, "HeldOutOptions::window");
+  Require(window % 2 == 1, "HeldOutOptions::window",
+          "is " + std::to_string(window) + " but must be odd");
+  RequireFieldRange(min_std, 0.0, 255.0, "HeldOutOptions::min_std");
+  RequireFieldRange(depth_tolerance_px, 0.01, 1000.0, "HeldOutOptions::depth_tolerance_px");
 }
 
 }  // namespace finecap

@@ -78,7 +78,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   double bytes = size.num_pixels * (kBytesPerPixel + kBytesPerPixelReadAhead) +
                  size.num_pairs * kBytesPerPair +
                  size.num_surface_gaussians * kBytesPerSurfaceGaussian;
-  if (options.energy.similarity == "consensus") {
+  if (options.energy.similarity == SimilarityType::kConsensus) {
     // Its colour tables (value and derivative, 3 floats each, per node) and the residuals and
     // Jacobians of the patches (3 channels of about 7 members, two doubles each) per
     // observation, and the sweep's cost matrix and its smoothing copy.

@@ -33,11 +33,16 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
   return ids;
 }
 
+const RefineOptions& Checked(const RefineOptions& options) {
+  options.Check();
+  return options;
+}
+
 }  // namespace
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
-    : stencil_(BuildLoopSubdivision(first_coarse, options.subdivision_levels, where)),
+    : stencil_(BuildLoopSubdivision(first_coarse, Checked(options).subdivision_levels, where)),
       num_coarse_vertices_(first_coarse.num_vertices()) {
   refined_vertices_ = FineMaskIds(stencil_, coarse_mask, num_coarse_vertices_);
   const Mesh fine = ApplySubdivision(stencil_, first_coarse.vertices);
@@ -67,23 +72,28 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
 
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
                                       const RefineOptions& options) {
+  options.Check();
   const Mesh fine = model.Subdivide(reference.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
   const auto visible = ComputeFrameVisibility(fine, normals, reference.cameras, options.visibility);
-  if (options.reference_colors == "image_model") {
+  if (options.reference_colors == ReferenceColorSource::kImageModel) {
     std::vector<std::string> names;
     for (const Camera& camera : reference.cameras) names.push_back(camera.name);
     const std::vector<ImageGaussians> images =
         BuildFrameImageGaussians(reference.images, {}, options.image, names);
     return ComputeModelReferenceColors(fine.vertices, normals, reference.cameras, images, visible,
-                                       options.sigma_hat, ParseOverlapForm(options.energy.overlap),
+                                       options.sigma_hat, options.energy.overlap,
                                        options.energy.reach_sigmas);
   }
   return ComputeReferenceColors(fine.vertices, normals, reference.cameras, reference.images,
                                 visible, options.image.color_space, options.sigma_hat);
 }
 
-PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+namespace {
+
+// PrepareFrame without checking `options`: the coarse levels of a schedule widen sigma_hat and the
+// leaves past the ranges that a configured value must lie in.
+PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame;
@@ -99,11 +109,10 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
   // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this
   // frame's own, taken as the reference frame's are, so no frame depends on another's surface.
   const ReferenceColors frame_colors =
-      options.energy.similarity == "consensus"
+      options.energy.similarity == SimilarityType::kConsensus
           ? ComputeModelReferenceColors(frame.fine.vertices, frame.normals, input.cameras,
                                         frame.images, visible, options.sigma_hat,
-                                        ParseOverlapForm(options.energy.overlap),
-                                        options.energy.reach_sigmas)
+                                        options.energy.overlap, options.energy.reach_sigmas)
           : colors;
   SurfaceGaussians surface = MakeSurfaceGaussians(frame.fine.vertices, frame.normals,
                                                   model.refined_vertices(), frame_colors);
@@ -118,6 +127,14 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
                                                options.energy);
   frame.seconds = SecondsSince(start);
   return frame;
+}
+
+}  // namespace
+
+PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options) {
+  options.Check();
+  return PrepareLevel(model, colors, input, options);
 }
 
 namespace {
@@ -161,8 +178,10 @@ RefineOptions LevelOptions(const RefineOptions& options, int level) {
   RefineOptions level_options = options;
   const double factor = std::pow(options.coarse_to_fine.scale, level);
   level_options.sigma_hat *= factor;
+  // Leaves grow with the level up to the largest an image model has.
   level_options.image.min_leaf_size =
-      std::max(1, static_cast<int>(std::lround(options.image.min_leaf_size * factor)));
+      std::clamp(static_cast<int>(std::lround(options.image.min_leaf_size * factor)), 1,
+                 ImageGaussianOptions::kMaxMinLeafSize);
   return level_options;
 }
 
@@ -177,7 +196,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     const RefineOptions level_options = LevelOptions(options, level);
     ReferenceColors level_colors = colors;
     level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
-    PreparedFrame frame = PrepareFrame(model, level_colors, input, level_options);
+    PreparedFrame frame = PrepareLevel(model, level_colors, input, level_options);
     *seconds_preparation += frame.seconds;
     if (k.size() == 0) k = starting_point(frame.energy.get());
     const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
@@ -195,13 +214,14 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
 FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
                                   const StartingPointFunction& starting_point) {
+  options.Check();
   const auto start = std::chrono::steady_clock::now();
   FrameResult result;
   SolverSummary coarse;
   const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
                                                      &coarse, &result.seconds_preparation);
 
-  PreparedFrame frame = PrepareFrame(model, colors, input, options);
+  PreparedFrame frame = PrepareLevel(model, colors, input, options);
   FrameEnergy& energy = *frame.energy;
   result.num_surface_gaussians = energy.num_parameters();
   result.num_image_gaussians = frame.num_image_gaussians;

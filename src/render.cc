@@ -317,17 +317,19 @@ void WritePixel(const Eigen::Vector3f& mean_rgb, cv::Vec3b* bgr) {
 }  // namespace
 
 void RenderOptions::Check() const {
-  const std::string where = "render options";
-  Require(supersampling >= 1 && supersampling <= 16, where + ".supersampling",
+  const std::string where = "RenderOptions::";
+  Require(supersampling >= 1 && supersampling <= 16, where + "supersampling",
           "must be between 1 and 16");
-  Require(std::isfinite(near_plane) && near_plane > 0.0, where + ".near_plane", "must be positive");
-  Require(std::isfinite(ambient) && ambient >= 0.0, where + ".ambient", "must be >= 0");
-  Require(std::isfinite(diffuse) && diffuse >= 0.0, where + ".diffuse", "must be >= 0");
-  Require(light_direction.allFinite() && light_direction.norm() > 0.0, where + ".light_direction",
+  Require(std::isfinite(near_plane) && near_plane >= 1e-9, where + "near_plane",
+          "must be at least 1e-9");
+  Require(std::isfinite(ambient) && ambient >= 0.0, where + "ambient", "must be >= 0");
+  Require(std::isfinite(diffuse) && diffuse >= 0.0, where + "diffuse", "must be >= 0");
+  Require(light_direction.allFinite() && light_direction.norm() > 0.0, where + "light_direction",
           "must be a finite non-zero vector");
   Require(background.allFinite() && background.minCoeff() >= 0.0 && background.maxCoeff() <= 1.0,
-          where + ".background", "must be RGB in [0, 1]");
-  Require(std::isfinite(noise_sigma) && noise_sigma >= 0.0, where + ".noise_sigma", "must be >= 0");
+          where + "background", "must be RGB in [0, 1]");
+  Require(std::isfinite(noise_sigma) && noise_sigma >= 0.0 && noise_sigma <= 255.0,
+          where + "noise_sigma", "must lie in [0, 255]");
 }
 
 DepthMap RenderDepth(const Camera& camera, const Mesh& mesh, const RenderOptions& options) {

@@ -21,7 +21,7 @@ double PaperSimilarityAtResult(const SequenceModel& model, const ReferenceColors
                                const FrameInput& input, const RefineOptions& refine,
                                const FrameStats& stats, const Eigen::VectorXd& k_fine) {
   RefineOptions options = refine;
-  options.energy.similarity = "paper";
+  options.energy.similarity = SimilarityType::kPaper;
   const PreparedFrame frame = PrepareFrame(model, colors, input, options);
   const std::vector<int>& ids = frame.energy->surface().vertex_ids;
   const Eigen::VectorXd solved = SolvedDisplacement(k_fine, stats.kept_input, options);

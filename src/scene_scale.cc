@@ -91,8 +91,9 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
   const SceneLengths& marks = options->scene_lengths;
   defaults.lengths = {
       Choose("model.sigma_hat",
-             options->energy.similarity == "consensus" ? factors.sigma_hat
-                                                       : factors.single_gaussian_sigma_hat,
+             options->energy.similarity == SimilarityType::kConsensus
+                 ? factors.sigma_hat
+                 : factors.single_gaussian_sigma_hat,
              s, &options->sigma_hat, marks.sigma_hat),
       Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
              factors.k_max_of_diagonal * defaults.scale.diagonal),
@@ -141,7 +142,7 @@ double BoundingBoxDiagonal(const Mesh& mesh) {
 void RequirePlausibleSceneScale(const Mesh& mesh, double sigma_hat, const std::string& where,
                                 const SceneScaleLimits& limits) {
   limits.Check();
-  Require(sigma_hat > 0.0, "model.sigma_hat", "must be positive");
+  Require(sigma_hat > 0.0, "sigma_hat", "must be positive");
   const double diagonal = BoundingBoxDiagonal(mesh);
   const double sigmas = diagonal / sigma_hat;
   if (sigmas >= limits.min_sigmas && sigmas <= limits.max_sigmas) return;

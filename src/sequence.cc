@@ -60,9 +60,9 @@ void RequireSameRecipe(const ReferenceColors& saved, const SequenceOptions& opti
               saved.method == refine.reference_colors,
           path,
           "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +
-              std::to_string(saved.sigma_hat) + " and method " + saved.method +
+              std::to_string(saved.sigma_hat) + " and method " + EnumToString(saved.method) +
               ", but the config asks for " + ColorSpaceName(refine.image.color_space) + ", " +
-              std::to_string(refine.sigma_hat) + " and " + refine.reference_colors +
+              std::to_string(refine.sigma_hat) + " and " + EnumToString(refine.reference_colors) +
               ": use another output folder");
 }
 

@@ -99,7 +99,7 @@ ReferenceColors ComputeModelReferenceColors(const Eigen::Matrix3Xd& vertices,
         *color = ImageColorAround(images[c], projected, form, reach_sigmas).cast<float>();
         return true;
       });
-  colors.method = "image_model";
+  colors.method = ReferenceColorSource::kImageModel;
   return colors;
 }
 
@@ -111,7 +111,7 @@ void WriteReferenceColors(const std::string& path, const ReferenceColors& colors
       << "# the vertex in the reference frame.\n"
       << "color_space " << ColorSpaceName(colors.color_space) << "\n"
       << std::setprecision(9) << "sigma_hat " << colors.sigma_hat << "\n"
-      << "method " << colors.method << "\n";
+      << "method " << EnumToString(colors.method) << "\n";
   if (!colors.recipe.empty()) text << "recipe " << colors.recipe << "\n";
   text << "vertices " << colors.colors.size() << "\n";
   for (size_t v = 0; v < colors.colors.size(); ++v) {
@@ -140,7 +140,11 @@ ReferenceColors ReadReferenceColors(const std::string& path, int expected_vertic
   read_header("color_space", &space_name);
   colors.color_space = ParseColorSpace(space_name, path);
   read_header("sigma_hat", &colors.sigma_hat);
-  read_header("method", &colors.method);
+  std::string method_name;
+  read_header("method", &method_name);
+  Require(
+      StringToEnum(method_name, &colors.method), path,
+      "unknown method '" + method_name + "'; expected " + JoinedEnumNames<ReferenceColorSource>());
   next_line();
   const std::string recipe_key = "recipe ";
   if (line.compare(0, recipe_key.size(), recipe_key) == 0) {  // Absent from older files.

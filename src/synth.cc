@@ -237,7 +237,7 @@ SyntheticCapture::SyntheticCapture(const SynthOptions& options) : impl_(std::mak
   if (options.single_wavelength > 0.0) {
     for (FoldComponent& fold : impl.options.folds) fold.wavelength = options.single_wavelength;
   }
-  impl.subject = options.subject == "skirt"
+  impl.subject = options.subject == SynthSubject::kSkirt
                      ? synth_internal::MakeSkirt(options.skirt, options.truth_refinement)
                      : synth_internal::MakeMeshSubject(options.mesh_path, options.num_frames,
                                                        options.truth_refinement);

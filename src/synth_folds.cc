@@ -10,9 +10,9 @@ namespace {
 
 double Radians(double degrees) { return degrees * M_PI / 180.0; }
 
-// Zero-mean cross-section of one wave period (phase in radians), peak-normalised for "sine".
-double Profile(const std::string& profile, double phase) {
-  if (profile == "ridge") return 4.0 / M_PI - 2.0 * std::abs(std::sin(0.5 * phase));
+// Zero-mean cross-section of one wave period (phase in radians), peak-normalised for kSine.
+double Profile(FoldProfile profile, double phase) {
+  if (profile == FoldProfile::kRidge) return 4.0 / M_PI - 2.0 * std::abs(std::sin(0.5 * phase));
   return std::sin(phase);
 }
 

@@ -201,25 +201,25 @@ void PaintPattern(const TextureOptions& options, double circumference, double he
   const StripeSequence warp(rng, palette, FittingRepeat(circumference, 0.12), 0.004, 0.03);
   const StripeSequence weft(rng, palette, 0.12, 0.004, 0.03);
   const auto plaid = [&](double x, double y) { return 0.5f * (warp.At(x) + weft.At(y)); };
-  if (options.pattern == "plaid") {
+  if (options.pattern == TexturePattern::kPlaid) {
     Fill(texture, circumference, height, plaid);
-  } else if (options.pattern == "stripes") {
+  } else if (options.pattern == TexturePattern::kStripes) {
     // Diagonal stripes at 30 degrees whose repeat fits around the subject.
     const double slope = std::tan(M_PI / 6.0);
     const StripeSequence diagonal(rng, palette, FittingRepeat(circumference, 0.1), 0.005, 0.025);
     Fill(texture, circumference, height,
          [&](double x, double y) { return diagonal.At(x + slope * y); });
-  } else if (options.pattern == "noise") {
+  } else if (options.pattern == TexturePattern::kNoise) {
     const PeriodicNoise second(rng, circumference, height, 0.025);
     Fill(texture, circumference, height, [&](double x, double y) {
       const float a = static_cast<float>(noise.At(x, y));
       const float b = static_cast<float>(second.At(x, y));
       return a * palette[0] + (1.0f - a) * palette[1] + (b - 0.5f) * palette[2];
     });
-  } else if (options.pattern == "print") {
+  } else if (options.pattern == TexturePattern::kPrint) {
     texture->setTo(cv::Scalar(palette[0][0], palette[0][1], palette[0][2]));
     DrawPrints(texture, rng, palette, circumference, height, 0.035);
-  } else {  // "mixed"
+  } else {  // kMixed
     Fill(texture, circumference, height, [&](double x, double y) {
       return plaid(x, y) * static_cast<float>(0.6 + 0.8 * noise.At(x, y));
     });

@@ -3,14 +3,15 @@
 #include <cmath>
 
 #include "finecap/error.h"
+#include "option_checks.h"
 
 namespace finecap {
 
 void VisibilityOptions::Check() const {
-  Require(depth_tolerance >= 0.0, "visibility.depth_tolerance", "must be non-negative");
-  Require(max_view_angle_deg > 0.0 && max_view_angle_deg <= 90.0, "visibility.max_view_angle_deg",
-          "must lie in (0, 90]");
-  Require(border_margin >= 0.0, "visibility.border_margin", "must be non-negative");
+  internal::RequireFieldRange(depth_tolerance, 0.0, 10.0, "VisibilityOptions::depth_tolerance");
+  internal::RequireFieldRange(max_view_angle_deg, 1.0, 90.0,
+                              "VisibilityOptions::max_view_angle_deg");
+  internal::RequireFieldRange(border_margin, 0.0, 1000.0, "VisibilityOptions::border_margin");
 }
 
 namespace {

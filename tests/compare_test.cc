@@ -43,13 +43,13 @@ TEST(CompareConfigTest, VariantsApplyDottedAndNestedSettingsInOrder) {
   const Config config = LoadConfig(file, {});
   ASSERT_EQ(config.compare.variants.size(), 2u);
   EXPECT_EQ(config.compare.variants[1].name, "ascent");
-  EXPECT_EQ(config.refine.solver.type, "ceres");  // The shared config is left as it is.
+  EXPECT_EQ(config.refine.solver.type, SolverType::kCeres);  // The shared config is left as it is.
 
   const Config ceres = VariantConfig(config, config.compare.variants[0]);
-  EXPECT_EQ(ceres.refine.solver.type, "ceres");
+  EXPECT_EQ(ceres.refine.solver.type, SolverType::kCeres);
   EXPECT_EQ(ceres.refine.solver.max_iterations, 3);
   const Config ascent = VariantConfig(config, config.compare.variants[1]);
-  EXPECT_EQ(ascent.refine.solver.type, "gradient_ascent");
+  EXPECT_EQ(ascent.refine.solver.type, SolverType::kGradientAscent);
   EXPECT_EQ(ascent.refine.solver.max_iterations, 4);
   EXPECT_DOUBLE_EQ(ascent.refine.energy.w_reg, 2.5e-7);
   EXPECT_DOUBLE_EQ(ascent.refine.energy.color_cutoff, config.refine.energy.color_cutoff);

@@ -90,7 +90,7 @@ TEST(ConfigSynthTest, EveryPresetLoadsAndItsValuesReachSynthOptions) {
     for (size_t i = 0; i < folds.size(); ++i) {
       EXPECT_EQ(synth.folds[i].wavelength, folds[i]["wavelength"].as<double>());
       EXPECT_EQ(synth.folds[i].amplitude, folds[i]["amplitude"].as<double>());
-      EXPECT_EQ(synth.folds[i].profile, folds[i]["profile"].as<std::string>());
+      EXPECT_EQ(EnumToString(synth.folds[i].profile), folds[i]["profile"].as<std::string>());
     }
     const YAML::Node distortion = file["cameras"]["distortion"];
     ASSERT_EQ(distortion.size(), 5u);
@@ -106,7 +106,7 @@ TEST(ConfigSynthTest, PresetValuesMatchTheirFiles) {
   EXPECT_EQ(demo.cameras.width, 512);
   EXPECT_EQ(demo.truth_refinement, 3);
   ASSERT_EQ(demo.folds.size(), 4u);
-  EXPECT_EQ(demo.folds[1].profile, "ridge");
+  EXPECT_EQ(demo.folds[1].profile, FoldProfile::kRidge);
   EXPECT_EQ(demo.folds[2].wavelength, 0.08);
   EXPECT_EQ(demo.folds[2].orientation, -15.0);
   EXPECT_EQ(demo.folds[2].phase, 200.0);
@@ -237,7 +237,7 @@ TEST(ConfigSynthTest, SetOverridesASynthKey) {
   EXPECT_EQ(config.synth.render.background, Eigen::Vector3d(1.0, 0.5, 0.0));
   ASSERT_EQ(config.synth.folds.size(), 2u);
   EXPECT_EQ(config.synth.folds[0].wavelength, 0.05);
-  EXPECT_EQ(config.synth.folds[0].profile, "ridge");
+  EXPECT_EQ(config.synth.folds[0].profile, FoldProfile::kRidge);
   // Keys a fold leaves out keep FoldComponent's defaults.
   EXPECT_EQ(config.synth.folds[0].amplitude, FoldComponent().amplitude);
   EXPECT_EQ(config.synth.folds[1].amplitude, -0.002);

@@ -14,8 +14,8 @@ namespace {
 
 EnergyOptions Options(const std::string& similarity, const std::string& overlap) {
   EnergyOptions options;
-  options.similarity = similarity;
-  options.overlap = overlap;
+  EXPECT_TRUE(StringToEnum(similarity, &options.similarity)) << similarity;
+  EXPECT_TRUE(StringToEnum(overlap, &options.overlap)) << overlap;
   options.k_max = 0.01;
   return options;
 }

@@ -104,7 +104,7 @@ TEST(HeldOutScoreTest, NearestCamerasAreOrderedByCentreDistance) {
 TEST(HeldOutScoreTest, RefusesBadOptionsAndImages) {
   HeldOutOptions options;
   options.window = 6;
-  ExpectErrorMentions([&] { options.Check(); }, {"validation.window"});
+  ExpectErrorMentions([&] { options.Check(); }, {"HeldOutOptions::window"});
   const SyntheticCapture capture(FoldedSkirtOptions());
   const SyntheticFrame frame = capture.Frame(0);
   CalibratedImage view{capture.true_cameras()[0], capture.Image(frame, 0, 0)};

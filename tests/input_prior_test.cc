@@ -117,7 +117,7 @@ TEST(PlainClothTest, HoldsWidePlainRegionsAndLeavesNarrowPatchesToTheRegulariser
 TEST(PriorCurvatureTest, AddsTheUniformPullAndTheScaledConfidencePull) {
   EnergyOptions options;
   options.w_prior = 2.0;
-  options.reg_unit = "mm";
+  options.reg_unit = RegUnit::kMillimetres;
   options.confidence_prior = 10.0;
   const Eigen::VectorXd data = (Eigen::VectorXd(5) << 4.0, 0.0, 1.0, 3.0, 2.0).finished();
   const Eigen::VectorXd plain = (Eigen::VectorXd(5) << 1.0, 0.0, 0.5, 0.0, 1.0).finished();

@@ -48,7 +48,7 @@ cv::Mat InteriorMask(cv::Size size, int margin) {
 void ExpectFlowOfAShift(const std::string& method) {
   const cv::Mat image = RandomTexture(128, 128);
   OpticalFlowOptions options;
-  options.method = method;
+  ASSERT_TRUE(StringToEnum(method, &options.method));
   const cv::Mat flow = ComputeOpticalFlow(image, Shifted(image, 3.0, -2.0), options, "shift");
   ASSERT_EQ(flow.type(), CV_32FC2);
   ASSERT_EQ(flow.size(), image.size());
@@ -98,12 +98,12 @@ TEST(OpticalFlowTest, ImprovementIsThePapersPercentage) {
 TEST(OpticalFlowTest, RefusesBadOptionsAndImages) {
   const cv::Mat image = RandomTexture(32, 32);
   OpticalFlowOptions options;
-  options.method = "farneback";
+  options.method = static_cast<FlowMethod>(5);
   ExpectErrorMentions([&] { ComputeOpticalFlow(image, image, options, "pair"); },
-                      {"method", "farneback", "dis, deepflow"});
+                      {"OpticalFlowOptions::method", "not a valid choice"});
   options = OpticalFlowOptions();
-  options.dis_preset = "slow";
-  ExpectErrorMentions([&] { options.Check(); }, {"dis_preset", "slow"});
+  options.dis_preset = static_cast<DisPreset>(-1);
+  ExpectErrorMentions([&] { options.Check(); }, {"OpticalFlowOptions::dis_preset"});
   ExpectErrorMentions(
       [&] { ComputeOpticalFlow(image, RandomTexture(32, 16), OpticalFlowOptions(), "cam0/7"); },
       {"cam0/7", "differ in size"});

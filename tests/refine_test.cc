@@ -48,15 +48,47 @@ TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
   EXPECT_GE(scheduled.summary.iterations, 2);
 }
 
+// Every entry point checks its options, so that a library caller's bad value is refused naming
+// the field instead of selecting a default.
+TEST_F(RefineFrameTest, EntryPointsRefuseBadOptionsNamingTheField) {
+  Capture capture = Capture::Open(*directory_);
+  const RefineOptions options;
+  const FrameInput input = ReadFrameInput(&capture, 1);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrameInput(&capture, 0), options);
+
+  RefineOptions bad = options;
+  bad.sigma_hat = -0.007;
+  testing_util::ExpectErrorMentions([&] { RefineFrame(model, colors, input, bad); },
+                                    {"RefineOptions::sigma_hat", "[1e-05, 1]"});
+  const Eigen::VectorXd start = Eigen::VectorXd::Zero(model.num_fine_vertices());
+  testing_util::ExpectErrorMentions([&] { RefineFrameFrom(model, colors, input, bad, start); },
+                                    {"RefineOptions::sigma_hat"});
+  testing_util::ExpectErrorMentions([&] { PrepareFrame(model, colors, input, bad); },
+                                    {"RefineOptions::sigma_hat"});
+  testing_util::ExpectErrorMentions([&] { SequenceModel(input.coarse, {}, bad, "test"); },
+                                    {"RefineOptions::sigma_hat"});
+
+  bad = options;
+  bad.reference_colors = static_cast<ReferenceColorSource>(7);
+  testing_util::ExpectErrorMentions(
+      [&] { ComputeSequenceColors(model, ReadFrameInput(&capture, 0), bad); },
+      {"RefineOptions::reference_colors", "not a valid choice"});
+  bad = options;
+  bad.sweep.samples = 2;
+  testing_util::ExpectErrorMentions([&] { RefineFrame(model, colors, input, bad); },
+                                    {"SweepOptions::samples", "0 (off)"});
+}
+
 TEST(CoarseToFineOptionsTest, RefusesLevelsAndScalesOutOfRange) {
   CoarseToFineOptions options;
   options.levels = 0;
   testing_util::ExpectErrorMentions([&] { options.Check(); },
-                                    {"refine.coarse_to_fine.levels", "[1, 5]"});
+                                    {"CoarseToFineOptions::levels", "[1, 5]"});
   options.levels = 2;
   options.scale = 1.0;
   testing_util::ExpectErrorMentions([&] { options.Check(); },
-                                    {"refine.coarse_to_fine.scale", "(1, 4]"});
+                                    {"CoarseToFineOptions::scale", "[1.0001, 4]"});
 }
 
 }  // namespace

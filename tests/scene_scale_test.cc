@@ -62,7 +62,7 @@ TEST(SceneScale, SigmaHatFollowsTheSimilarity) {
   for (const std::string similarity : {"consensus", "surface_color", "paper"}) {
     RefineOptions options;
     options.subdivision_levels = 0;
-    options.energy.similarity = similarity;
+    ASSERT_TRUE(StringToEnum(similarity, &options.energy.similarity)) << similarity;
     ResolveSceneScaleDefaults(grid, {camera}, "grid.ply", &options);
     const double factor =
         similarity == "consensus" ? factors.sigma_hat : factors.single_gaussian_sigma_hat;

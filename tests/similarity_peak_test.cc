@@ -98,12 +98,12 @@ class SimilarityPeakTest : public ::testing::Test {
     ours_.subdivision_levels = 0;
     ours_.sigma_hat = 0.004;
     paper_ = ours_;
-    paper_.energy.similarity = "paper";
-    paper_.reference_colors = "pixels";
+    paper_.energy.similarity = SimilarityType::kPaper;
+    paper_.reference_colors = ReferenceColorSource::kPixels;
     paper_.image.color_space = ColorSpace::kHsv;
     paper_.image.min_leaf_size = 4;
     consensus_ = ours_;
-    consensus_.energy.similarity = "consensus";
+    consensus_.energy.similarity = SimilarityType::kConsensus;
     consensus_.image.color_space = ColorSpace::kNormalizedRgb;
   }
 

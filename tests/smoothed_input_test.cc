@@ -89,7 +89,7 @@ TEST(SmoothedInputTest, DetailedUserSequenceBecomesARefinableBenchmark) {
   // The sequence is the truth (no subdivision, no procedural folds); its smoothed copies are the
   // input. 3 cameras of 96 x 96.
   SynthOptions synth = testing_util::TinyRefinableSynthOptions(kFrames);
-  synth.subject = "mesh";
+  synth.subject = SynthSubject::kMesh;
   synth.mesh_path = sequence;
   synth.truth_refinement = 1;
   synth.folds.clear();

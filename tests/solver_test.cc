@@ -11,8 +11,8 @@ namespace {
 
 EnergyOptions Options(const std::string& similarity, const std::string& overlap) {
   EnergyOptions options;
-  options.similarity = similarity;
-  options.overlap = overlap;
+  EXPECT_TRUE(StringToEnum(similarity, &options.similarity)) << similarity;
+  EXPECT_TRUE(StringToEnum(overlap, &options.overlap)) << overlap;
   options.k_max = 0.01;
   options.w_reg = 1e-3;
   return options;
@@ -148,7 +148,7 @@ TEST_P(SolverTest, ImprovesTheEnergyWithinBounds) {
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options("surface_color", "printed"));
   SolverOptions options;
-  options.type = GetParam();
+  ASSERT_TRUE(StringToEnum(std::string(GetParam()), &options.type));
   options.max_iterations = 30;
   Eigen::VectorXd k = Eigen::VectorXd::Constant(energy.num_parameters(), 0.004);
   const SolverSummary summary = Solve(&energy, options, &k);
@@ -175,9 +175,9 @@ TEST(SolverTest, CeresAndLbfgsReachTheSameOptimum) {
   options.function_tolerance = 1e-12;
   Eigen::VectorXd k_ceres = Eigen::VectorXd::Zero(energy.num_parameters());
   Eigen::VectorXd k_lbfgs = k_ceres;
-  options.type = "ceres";
+  options.type = SolverType::kCeres;
   const SolverSummary ceres = Solve(&energy, options, &k_ceres);
-  options.type = "lbfgs";
+  options.type = SolverType::kLbfgs;
   const SolverSummary lbfgs = Solve(&energy, options, &k_lbfgs);
   EXPECT_NEAR(ceres.ls_cost_end, -ceres.energy_end, 1e-12 * std::abs(ceres.energy_end));
   EXPECT_NEAR(ceres.energy_end, lbfgs.energy_end, 1e-6 * std::abs(ceres.energy_end));
@@ -191,7 +191,7 @@ TEST(SolverTest, GradientAscentReturnsItsBestIterate) {
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options("surface_color", "printed"));
   SolverOptions options;
-  options.type = "gradient_ascent";
+  options.type = SolverType::kGradientAscent;
   options.initial_step = 0.01;
   options.max_step = 0.01;
   options.step_shrink = 0.99;

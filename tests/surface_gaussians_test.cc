@@ -16,7 +16,7 @@ ReferenceColors SomeColors() {
   ReferenceColors colors;
   colors.color_space = ColorSpace::kChromaticity;
   colors.sigma_hat = 0.0055;
-  colors.method = "image_model";
+  colors.method = ReferenceColorSource::kImageModel;
   colors.colors = {Eigen::Vector3f(0.1f, 0.25f, 0.6f), Eigen::Vector3f(0.3f, 0.3f, 0.3f),
                    Eigen::Vector3f(0.0f, 0.0f, 0.0f)};
   colors.valid = {1, 1, 0};
@@ -35,7 +35,7 @@ TEST(ReferenceColorsTest, RoundTripKeepsEveryField) {
   const ReferenceColors read = ReadReferenceColors(path, 3);
   EXPECT_EQ(read.color_space, written.color_space);
   EXPECT_DOUBLE_EQ(read.sigma_hat, written.sigma_hat);
-  EXPECT_EQ(read.method, "image_model");
+  EXPECT_EQ(read.method, ReferenceColorSource::kImageModel);
   EXPECT_EQ(read.recipe, written.recipe);
   EXPECT_EQ(read.valid, written.valid);
   for (int v = 0; v < 3; ++v) EXPECT_LT((read.colors[v] - written.colors[v]).norm(), 1e-7f);

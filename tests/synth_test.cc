@@ -220,7 +220,8 @@ TEST(SynthTest, BadSmoothingStrengthIsRefusedNamingTheKey) {
     GenerateSyntheticCapture(options, out);
     FAIL() << "no error";
   } catch (const Error& error) {
-    EXPECT_NE(std::string(error.what()).find("synth.smoothing.iterations"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("SynthOptions::smoothing.iterations"),
+              std::string::npos)
         << error.what();
   }
   EXPECT_FALSE(fs::exists(out));
@@ -328,7 +329,8 @@ TEST(SynthTest, DistortedImagesUndistortBackToThePinholeRender) {
   options.cameras.focal = 140.0;
   options.cameras.distance = 1.0;  // Close, so that the skirt reaches where distortion is strong.
   options.render.supersampling = 2;
-  options.texture.pattern = "noise";  // Smooth, so that resampling twice blurs little.
+  options.texture.pattern =
+      TexturePattern::kNoise;  // Smooth, so that resampling twice blurs little.
   const SyntheticCapture pinhole(options);
   options.cameras.distortion = {-0.35, 0.1, 0.001, -0.002, 0.0};
   const SyntheticCapture distorted(options);
@@ -361,7 +363,7 @@ TEST(SynthTest, UserMeshGetsSubdividedAndFolded) {
   WriteMesh(folder + "/b.ply", source.Frame(1).coarse);
 
   SynthOptions options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.mesh_path = folder;
   options.truth_refinement = 2;
   const SyntheticCapture capture(options);
@@ -389,7 +391,7 @@ TEST(SynthTest, UserMeshFolderWithChangingTopologyIsRefused) {
   std::swap(second.faces(1, 0), second.faces(2, 0));
   WriteMesh(folder + "/001.ply", second);
   SynthOptions options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.mesh_path = folder;
   options.truth_refinement = 2;
   const SyntheticCapture capture(options);
@@ -408,10 +410,11 @@ TEST(SynthTest, InvalidOptionsNameTheField) {
     options.Check();
     FAIL() << "no error";
   } catch (const Error& error) {
-    EXPECT_NE(std::string(error.what()).find("synth.folds[1].wavelength"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("SynthOptions::folds[1].wavelength"),
+              std::string::npos);
   }
   options = TinyOptions();
-  options.subject = "mesh";
+  options.subject = SynthSubject::kMesh;
   options.truth_refinement = 3;
   options.mesh_path = "x.ply";
   EXPECT_THROW(options.Check(), Error);

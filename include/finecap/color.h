@@ -35,15 +35,20 @@
 #define FINECAP_COLOR_H_
 
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "finecap/enum_names.h"
+
 namespace finecap {
 
 enum class ColorSpace { kHsv, kNormalizedRgb, kLab, kChromaticity };
+// The names used in config files: "hsv", "normalized_rgb", "lab" and "chromaticity".
+const std::vector<EnumName<ColorSpace>>& EnumNames(ColorSpace);
 
-// The name used in config files: "hsv", "normalized_rgb", "lab" or "chromaticity".
+// EnumToString(space).
 std::string ColorSpaceName(ColorSpace space);
 
 // Inverse of ColorSpaceName (exact, lower case). Throws Error(where, ...) listing the valid names

@@ -97,6 +97,15 @@ struct Config {
   FrameRange frame_range() const { return ParseFrameRange(capture.frames, "capture.frames"); }
 };
 
+// The config key that holds the options field a Check() names (Error::where(), e.g.
+// "RefineOptions::sigma_hat" -> "model.sigma_hat"; a part of a key, such as
+// "synth.folds[1].profile", for a field inside a list); "" when no key holds it.
+std::string ConfigKeyOfField(const std::string& field);
+
+// config.Check(), throwing an Error that names `source` (a file, or a variant) and, where a key
+// holds the field that failed, that key.
+void CheckConfig(const Config& config, const std::string& source);
+
 // Binds every config key to a field of `*config`, which must outlive the schema.
 ConfigSchema MakeConfigSchema(Config* config);
 

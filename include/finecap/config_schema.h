@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "finecap/enum_names.h"
+
 namespace YAML {
 class Node;
 }
@@ -37,6 +39,16 @@ class ConfigSchema {
   void AddString(const std::string& path, std::string* field, const std::string& doc);
   void AddChoice(const std::string& path, std::string* field, const std::string& doc,
                  const std::vector<std::string>& choices);
+  // A choice bound to an enum: the allowed values are the names of its table (enum_names.h).
+  template <typename Enum>
+  void AddEnum(const std::string& path, Enum* field, const std::string& doc) {
+    AddChoiceKey(
+        path, doc, EnumNameList<Enum>(),
+        [field](const std::string& name) { StringToEnum(name, field); },
+        [field] { return EnumToString(*field); });
+  }
+  // An integer that is 0 (the feature is off) or lies in [min, max].
+  void AddIntOrOff(const std::string& path, int* field, const std::string& doc, int min, int max);
   void AddDoubleList(const std::string& path, std::vector<double>* field, const std::string& doc,
                      double min = std::numeric_limits<double>::lowest(),
                      double max = std::numeric_limits<double>::max());
@@ -47,6 +59,10 @@ class ConfigSchema {
                  const std::string& doc,
                  std::function<void(const YAML::Node& value, const std::string& where)> assign,
                  std::function<std::string()> current_text);
+
+  // A former name of key `path` (which must be registered), still read and set as `path` so
+  // that older configs keep working; help and the README list it as such.
+  void AddAlias(const std::string& old_path, const std::string& path);
 
   // Reads a YAML file into the bound fields. Keys absent from the file keep their values.
   void ReadFile(const std::string& file);
@@ -59,6 +75,19 @@ class ConfigSchema {
   bool Has(const std::string& path) const;
   // The value of a key in YAML syntax, as it is now.
   std::string ValueText(const std::string& path) const;
+
+  // A numeric key (int or float, not an alias) with its allowed range, and a way to write its
+  // field past that range: for tests that hold the options structs' Check()s to the schema.
+  struct NumericKey {
+    std::string path;
+    bool is_integer = false;
+    // The bounds; the type's lowest() / max() when a side is unbounded.
+    double min = 0.0;
+    double max = 0.0;
+    bool zero_also = false;  // 0 is allowed outside [min, max] too (AddIntOrOff).
+    std::function<void(double)> write_unchecked;
+  };
+  std::vector<NumericKey> NumericKeys() const;
 
   // One line per key below `prefix` ("" for all): path, type, default, range, documentation.
   std::string HelpText(const std::string& prefix = "") const;
@@ -75,9 +104,26 @@ class ConfigSchema {
     // Parses and checks a YAML value, then writes the field; throws Error(where, ...) on failure.
     std::function<void(const YAML::Node& value, const std::string& where)> assign;
     std::function<std::string()> current_text;
+    std::string alias_of;  // For a former name: the key it stands for.
+    // Numeric keys only: the range, and a writer of the field that skips its checks.
+    bool is_numeric = false;
+    double min = 0.0;
+    double max = 0.0;
+    bool zero_also = false;
+    std::function<void(double)> write_unchecked;
   };
 
+  static Key MakeKey(const std::string& path, const std::string& type, const std::string& range,
+                     const std::string& doc,
+                     std::function<void(const YAML::Node& value, const std::string& where)> assign,
+                     std::function<std::string()> current_text);
   void AddKey(Key key);
+  template <typename T>
+  static void SetNumeric(T min, T max, std::function<void(double)> write_unchecked, Key* key);
+  void AddChoiceKey(const std::string& path, const std::string& doc,
+                    const std::vector<std::string>& choices,
+                    std::function<void(const std::string&)> set,
+                    std::function<std::string()> current_text);
   const Key* Find(const std::string& path) const;
   void ReadMapping(const YAML::Node& mapping, const std::string& prefix, const std::string& file);
 

@@ -3,8 +3,20 @@
 #define FINECAP_ENERGY_OPTIONS_H_
 
 #include <string>
+#include <vector>
+
+#include "finecap/enum_names.h"
+#include "finecap/gaussian_overlap.h"
 
 namespace finecap {
+
+// What the similarity E_sim measures (EnergyOptions::similarity).
+enum class SimilarityType { kPaper, kSurfaceColor, kConsensus };
+const std::vector<EnumName<SimilarityType>>& EnumNames(SimilarityType);
+
+// The unit in which k enters E_reg (EnergyOptions::reg_unit).
+enum class RegUnit { kMillimetres, kMetres };
+const std::vector<EnumName<RegUnit>>& EnumNames(RegUnit);
 
 // Options of the consensus similarity (consensus_similarity.h).
 struct ConsensusOptions {
@@ -33,21 +45,21 @@ struct ConsensusOptions {
 
 struct EnergyOptions {
   // Which similarity E_sim measures:
-  //  "paper":         the paper's E_sim as printed, with the min() clamp per image Gaussian;
-  //  "surface_color": each surface Gaussian's colour against the image colour around its
+  //  kPaper:         the paper's E_sim as printed, with the min() clamp per image Gaussian;
+  //  kSurfaceColor:  each surface Gaussian's colour against the image colour around its
   //                   projection, the overlap-weighted mean of the image Gaussians' colours (a
   //                   closed-form least-squares residual per surface Gaussian and camera; see
   //                   the README for why it peaks at the true surface where the paper's does not);
-  //  "consensus":     the cameras that see a patch of surface Gaussians must agree on its
+  //  kConsensus:     the cameras that see a patch of surface Gaussians must agree on its
   //                   normalised colours; no reference colours (consensus_similarity.h).
-  // Default "consensus": on captures whose reference frame is as coarse as any other (every real
+  // Default kConsensus: on captures whose reference frame is as coarse as any other (every real
   // one) it recovers detail where surface_color, whose reference colours then belong to the
   // wrong surface points, does not (measured with `finecap probe` and `finecap refine`, see the
   // README; configs/surface_color.yaml keeps surface_color's settings).
-  std::string similarity = "consensus";
-  // Closed form of the overlap of two Gaussians: "printed" (the paper's equation) or "exact"
-  // (the true integral, half the exponent). See gaussian_overlap.h.
-  std::string overlap = "printed";
+  SimilarityType similarity = SimilarityType::kConsensus;
+  // Closed form of the overlap of two Gaussians: kPrinted (the paper's equation), kExact (the
+  // true integral, half the exponent) or kPatch. See gaussian_overlap.h.
+  OverlapForm overlap = OverlapForm::kPrinted;
   // Cut-off D of the Wendland colour weight T(|eta_i - eta_s|) of the paper's E_sim, in colour
   // distance units (color.h). Paper: 0.05.
   double color_cutoff = 0.05;
@@ -89,11 +101,11 @@ struct EnergyOptions {
   // Neighbourhood size Delta of the regulariser, edges; also the Wendland cut-off of its weights
   // T(delta_sj). Paper: 2.
   int reg_rings = 2;
-  // Unit in which k enters E_reg: "mm" (the paper's lengths) or "m".
-  std::string reg_unit = "mm";
+  // Unit in which k enters E_reg: millimetres (the paper's lengths) or metres.
+  RegUnit reg_unit = RegUnit::kMillimetres;
 
   // Metres to the unit of E_reg.
-  double RegUnitScale() const { return reg_unit == "mm" ? 1000.0 : 1.0; }
+  double RegUnitScale() const { return reg_unit == RegUnit::kMillimetres ? 1000.0 : 1.0; }
   void Check() const;
 };
 

@@ -13,7 +13,18 @@ class Error : public std::runtime_error {
  public:
   // `where` is the file, folder or config key the problem is in; it may be empty.
   Error(const std::string& where, const std::string& problem)
-      : std::runtime_error(where.empty() ? problem : where + ": " + problem) {}
+      : std::runtime_error(where.empty() ? problem : where + ": " + problem),
+        where_(where),
+        problem_(problem) {}
+
+  // The two parts of the message, e.g. for a caller that names `where` otherwise (the config
+  // layer reports an options struct's field, "RefineOptions::sigma_hat", as its config key).
+  const std::string& where() const { return where_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  std::string where_;
+  std::string problem_;
 };
 
 // Throws Error(where, problem) unless `condition` holds.

@@ -15,9 +15,11 @@
 #define FINECAP_GAUSSIAN_OVERLAP_H_
 
 #include <cmath>
-#include <string>
+#include <vector>
 
 #include <Eigen/Core>
+
+#include "finecap/enum_names.h"
 
 namespace finecap {
 
@@ -26,8 +28,7 @@ namespace finecap {
 // exponent is the exact one, -|d|^2 / (2S). Then the overlap-weighted mean colour of the image
 // Gaussians is the image blurred by the surface Gaussian (up to the squares' shape).
 enum class OverlapForm { kPrinted, kExact, kPatch };
-
-OverlapForm ParseOverlapForm(const std::string& name);  // "printed" or "exact".
+const std::vector<EnumName<OverlapForm>>& EnumNames(OverlapForm);  // printed, exact, patch.
 
 // Where a surface Gaussian projects in one camera, and how that moves with k:
 // pixel mean m, projected standard deviation sigma = sigma_hat * f / z, and their k-derivatives.

@@ -48,13 +48,18 @@ struct ImageGaussianOptions {
   // depth in [0, max_depth]. In [0, 16]. Default: 8, the paper's value.
   int max_depth = 8;
 
-  // Side of the smallest leaf, pixels; its Gaussian has sigma min_leaf_size / 2. At least 1, and
-  // RootSide() may not exceed 2^20. Default: 4 (sigma 2 px, about the projected size of the
-  // paper's 7 mm surface Gaussians at 2-3 m with a focal length of ~1000 px).
+  // The largest RootSide(), and the largest min_leaf_size, pixels.
+  static constexpr int kMaxRootSide = 1 << 20;
+  static constexpr int kMaxMinLeafSize = 1024;
+
+  // Side of the smallest leaf, pixels; its Gaussian has sigma min_leaf_size / 2. In
+  // [1, kMaxMinLeafSize], and RootSide() may not exceed kMaxRootSide. Default: 4 (sigma 2 px, about
+  // the projected size of the paper's 7 mm surface Gaussians at 2-3 m with a focal length of ~1000
+  // px).
   int min_leaf_size = 4;
 
   // Largest colour spread (RMS colour distance to the mean, units of ColorDistance) a leaf may
-  // have. Non-negative. Default: 0.025, half the paper's colour cut-off D = 0.05, so that the
+  // have. In [0, 10]. Default: 0.025, half the paper's colour cut-off D = 0.05, so that the
   // typical pixel of a leaf lies well inside the range in which colours still count as similar.
   double split_threshold = 0.025;
 

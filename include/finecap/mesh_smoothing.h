@@ -50,7 +50,7 @@ struct TaubinSmoothingOptions {
 // clamped at zero, uniform for a vertex whose weights sum to zero) make the smoothing follow the
 // surface's shape in metres rather than how it happens to be triangulated. Boundary vertices are
 // smoothed like the others; vertices in no triangle keep their place. Throws Error (through
-// options.Check("smoothing")) on invalid options.
+// options.Check("TaubinSmoothingOptions")) on invalid options.
 Eigen::Matrix3Xd TaubinSmooth(const Mesh& mesh, const TaubinSmoothingOptions& options);
 
 }  // namespace finecap

@@ -9,19 +9,30 @@
 #define FINECAP_OPTICAL_FLOW_H_
 
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "finecap/enum_names.h"
+
 namespace finecap {
 
+// kDis ("dis"): OpenCV's Dense Inverse Search (Kroeger et al. 2016), fast; kDeepFlow
+// ("deepflow"): DeepFlow (Weinzaepfel et al. 2013, opencv_contrib's optflow module), slower
+// (seconds per megapixel) but closer to the variational flow of the paper's time.
+enum class FlowMethod { kDis, kDeepFlow };
+const std::vector<EnumName<FlowMethod>>& EnumNames(FlowMethod);
+
+// OpenCV's presets of DIS, "ultrafast", "fast" and "medium": coarser patches and fewer
+// iterations are faster and less precise.
+enum class DisPreset { kUltrafast, kFast, kMedium };
+const std::vector<EnumName<DisPreset>>& EnumNames(DisPreset);
+
 struct OpticalFlowOptions {
-  // "dis": OpenCV's Dense Inverse Search (Kroeger et al. 2016), fast and the default;
-  // "deepflow": DeepFlow (Weinzaepfel et al. 2013, opencv_contrib's optflow module), slower
-  // (seconds per megapixel) but closer to the variational flow of the paper's time.
-  std::string method = "dis";
-  // DIS only: "ultrafast", "fast" or "medium" (OpenCV's presets; coarser patches and fewer
-  // iterations are faster and less precise). Default "medium".
-  std::string dis_preset = "medium";
+  // Default kDis.
+  FlowMethod method = FlowMethod::kDis;
+  // DIS only. Default kMedium.
+  DisPreset dis_preset = DisPreset::kMedium;
 
   // Throws Error naming the field when a value is not one of those above.
   void Check() const;

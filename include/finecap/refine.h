@@ -17,6 +17,7 @@
 
 #include "finecap/camera.h"
 #include "finecap/energy_options.h"
+#include "finecap/enum_names.h"
 #include "finecap/frame_energy.h"
 #include "finecap/image_gaussians.h"
 #include "finecap/mesh.h"
@@ -69,11 +70,11 @@ struct RefineOptions {
   // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007. Follows from
   // the scene unless set (scene_lengths).
   double sigma_hat = 0.007;
-  // How the reference frame colours the surface Gaussians: "pixels" (the paper: the mean of the
-  // pixels under the projected Gaussian in the best-aligned camera) or "image_model" (in that
+  // How the reference frame colours the surface Gaussians: kPixels (the paper: the mean of the
+  // pixels under the projected Gaussian in the best-aligned camera) or kImageModel (in that
   // camera, what the energy's image model shows there; see ComputeModelReferenceColors).
-  // Default "image_model" (the paper: "pixels").
-  std::string reference_colors = "image_model";
+  // Default kImageModel (the paper: kPixels).
+  ReferenceColorSource reference_colors = ReferenceColorSource::kImageModel;
   // After solving, add sigma_hat along the normal to every refined vertex, compensating the
   // slight shrink the Gaussians' extent causes (the paper's section 6). Default false: the
   // surface-colour similarity has no such shrink (configs/paper.yaml turns it on).

@@ -18,13 +18,26 @@
 
 #include <Eigen/Core>
 
+#include "finecap/enum_names.h"
 #include "finecap/frame_energy.h"
 
 namespace finecap {
 
+// Which solver maximises the energy (the list above).
+enum class SolverType { kCeres, kGradientAscent, kLbfgs };
+const std::vector<EnumName<SolverType>>& EnumNames(SolverType);
+
+// Ceres' trust-region strategy (ceres::TrustRegionStrategyType).
+enum class TrustRegionType { kLevenbergMarquardt, kDogleg };
+const std::vector<EnumName<TrustRegionType>>& EnumNames(TrustRegionType);
+
+// Ceres' linear solver (ceres::LinearSolverType): sparse Cholesky of the normal equations
+// (SuiteSparse), conjugate gradients on them (inexact steps), or dense QR (tiny problems only).
+enum class LinearSolverType { kSparseNormalCholesky, kCgnr, kDenseQr };
+const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType);
+
 struct SolverOptions {
-  // "ceres", "gradient_ascent" or "lbfgs".
-  std::string type = "ceres";
+  SolverType type = SolverType::kCeres;
   // Most iterations. Paper (gradient ascent): 150.
   int max_iterations = 50;
   // Stop when the energy changes by less than this fraction of its value. Default 1e-3: on
@@ -33,11 +46,10 @@ struct SolverOptions {
   // Threads of Ceres' evaluation and linear algebra; 0 = all cores.
   int num_threads = 0;
 
-  // Ceres only: trust-region strategy, "levenberg_marquardt" or "dogleg".
-  std::string trust_region = "levenberg_marquardt";
-  // Ceres only: "sparse_normal_cholesky" (SuiteSparse), "iterative_schur"... see the README;
-  // "cgnr" (conjugate gradients on the normal equations, inexact steps) is the iterative option.
-  std::string linear_solver = "sparse_normal_cholesky";
+  // Ceres only: trust-region strategy.
+  TrustRegionType trust_region = TrustRegionType::kLevenbergMarquardt;
+  // Ceres only: the linear solver; kCgnr is the iterative option.
+  LinearSolverType linear_solver = LinearSolverType::kSparseNormalCholesky;
 
   // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
   // are scaled from it). Default 0.5 mm; a refinement makes it follow from the scene unless set
@@ -61,7 +73,7 @@ struct SolverIteration {
 };
 
 struct SolverSummary {
-  std::string solver;
+  std::string solver;         // The name of SolverOptions::type.
   double energy_start = 0.0;  // E = E_sim - w_reg E_reg of the configured energy.
   double energy_end = 0.0;
   double ls_cost_start = 0.0;  // 1/2 sum of squared residuals of the least-squares form.

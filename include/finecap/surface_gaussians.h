@@ -12,6 +12,7 @@
 
 #include "finecap/camera.h"
 #include "finecap/color.h"
+#include "finecap/enum_names.h"
 #include "finecap/gaussian_overlap.h"
 #include "finecap/image_gaussians.h"
 
@@ -29,12 +30,17 @@ struct SurfaceGaussians {
   int size() const { return static_cast<int>(vertex_ids.size()); }
 };
 
+// How the reference frame colours the surface Gaussians: the mean of the pixels under each
+// projected Gaussian (the paper), or what the image model shows there.
+enum class ReferenceColorSource { kPixels, kImageModel };
+const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSource);
+
 // Colours of the vertices of a mesh, taken from one frame's images, with a flag per vertex that
 // says whether any camera saw it. Saved once per sequence so that any frame can run on its own.
 struct ReferenceColors {
   ColorSpace color_space = ColorSpace::kHsv;
-  double sigma_hat = 0.007;       // The footprint they were averaged over, metres.
-  std::string method = "pixels";  // How they were taken: "pixels" or "image_model".
+  double sigma_hat = 0.007;  // The footprint they were averaged over, metres.
+  ReferenceColorSource method = ReferenceColorSource::kPixels;  // How they were taken.
   // What they were computed from, one line (ReferenceColorRecipe, sequence.h); saved in the file
   // so that a run reusing it can check it. Empty in files saved before recipes were.
   std::string recipe;

@@ -15,7 +15,12 @@
 namespace finecap {
 
 struct SweepOptions {
-  // Number of displacements tried in [-k_max, k_max]; 0 turns the sweep off. Default 33: with the
+  // The bounds of `samples` when the sweep is on.
+  static constexpr int kMinSamples = 3;
+  static constexpr int kMaxSamples = 1000;
+
+  // Number of displacements tried in [-k_max, k_max]: 0 (off) or in [kMinSamples, kMaxSamples].
+  // Default 33: with the
   // consensus similarity's tabulated colours a sample costs little, and a start from the best
   // displacement of each patch reaches inputs farther from the truth (the temple's visual hull).
   int samples = 33;

@@ -28,6 +28,7 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/camera.h"
+#include "finecap/enum_names.h"
 #include "finecap/mesh.h"
 #include "finecap/mesh_smoothing.h"
 #include "finecap/render.h"
@@ -43,6 +44,10 @@ namespace finecap {
 // radius): the folds close up seamlessly around the body, and on a flared skirt they fan out
 // towards the hem (shorter than `wavelength` at the waist, longer at the hem) as real ones do.
 // With orientation 90 the wavelength is exact everywhere.
+// The cross-section of a fold (FoldComponent::profile): "sine" or "ridge".
+enum class FoldProfile { kSine, kRidge };
+const std::vector<EnumName<FoldProfile>>& EnumNames(FoldProfile);
+
 struct FoldComponent {
   // Peak displacement along the outward normal, metres; a negative value flips the folds.
   // Typical 0.002 to 0.02. Default 0.008.
@@ -56,9 +61,9 @@ struct FoldComponent {
   double phase = 0.0;
   // Phase change per frame, degrees: the folds drift over the surface. Default 6.
   double drift = 6.0;
-  // Cross-section of a fold: "sine", or "ridge" (sharp crests and broad troughs, zero mean,
-  // 4/pi * amplitude high and 2 - 4/pi below). Default "sine".
-  std::string profile = "sine";
+  // Cross-section of a fold: kSine, or kRidge (sharp crests and broad troughs, zero mean,
+  // 4/pi * amplitude high and 2 - 4/pi below). Default kSine.
+  FoldProfile profile = FoldProfile::kSine;
 
   // Throws Error naming `where` and the field when a value is out of range.
   void Check(const std::string& where) const;
@@ -93,14 +98,18 @@ struct SkirtOptions {
   void Check() const;
 };
 
+// The cloth print (TextureOptions::pattern): "mixed" (plaid, printed motifs and noise together),
+// "plaid", "stripes", "print" or "noise".
+enum class TexturePattern { kMixed, kPlaid, kStripes, kPrint, kNoise };
+const std::vector<EnumName<TexturePattern>>& EnumNames(TexturePattern);
+
 // The procedural cloth print, generated in texture (u, v) space.
 struct TextureOptions {
   // Texture image size in texels. Defaults 2048 x 1024.
   int width = 2048;
   int height = 1024;
-  // "mixed" (plaid, printed motifs and noise together), "plaid", "stripes", "print" or "noise".
-  // Default "mixed".
-  std::string pattern = "mixed";
+  // The print. Default kMixed.
+  TexturePattern pattern = TexturePattern::kMixed;
   // A band of the surface painted in one plain colour: from textureless_begin to textureless_end,
   // as fractions of the subject's height measured from its top (0 to 1). No band when they are
   // equal. Defaults 0 and 0.
@@ -154,11 +163,17 @@ enum class CoarseInput {
   // the coarse meshes smooth.
   kSmoothed,
 };
+const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput);  // unfolded, smoothed.
+
+// What a synthetic capture shows (SynthOptions::subject): "skirt" (the built-in flared tube) or
+// "mesh" (meshes from files).
+enum class SynthSubject { kSkirt, kMesh };
+const std::vector<EnumName<SynthSubject>>& EnumNames(SynthSubject);
 
 struct SynthOptions {
-  // "skirt" (the built-in flared tube, see `skirt`) or "mesh" (the meshes at `mesh_path`).
-  // Default "skirt".
-  std::string subject = "skirt";
+  // kSkirt (the built-in flared tube, see `skirt`) or kMesh (the meshes at `mesh_path`).
+  // Default kSkirt.
+  SynthSubject subject = SynthSubject::kSkirt;
   SkirtOptions skirt;
   // For subject "mesh": a mesh file (the subject stands still) or a folder of per-frame meshes
   // sharing one topology, taken in name order (.ply, .obj, .off, .stl). World y must point up.
@@ -175,9 +190,9 @@ struct SynthOptions {
 
   // The folds, summed. Default: three families of 8-20 cm waves in different directions.
   std::vector<FoldComponent> folds = {
-      {0.009, 0.16, 0.0, 0.0, 5.0, "sine"},
-      {0.006, 0.10, 25.0, 40.0, -7.0, "ridge"},
-      {0.004, 0.20, 70.0, 120.0, 4.0, "sine"},
+      {0.009, 0.16, 0.0, 0.0, 5.0, FoldProfile::kSine},
+      {0.006, 0.10, 25.0, 40.0, -7.0, FoldProfile::kRidge},
+      {0.004, 0.20, 70.0, 120.0, 4.0, FoldProfile::kSine},
   };
   // When > 0, every fold gets this wavelength (metres): captures with one fold scale. Default 0.
   double single_wavelength = 0.0;

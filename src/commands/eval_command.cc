@@ -18,8 +18,9 @@ RunEvaluationOptions EvaluationOptionsOf(const Config& config) {
   options.reference_frame = config.reference_frame;
   options.camera = config.eval.camera;
   options.measure_flow = config.eval.flow != "none";
-  if (options.measure_flow) options.flow.method = config.eval.flow;
-  options.flow.dis_preset = config.eval.flow_dis_preset;
+  // The schema allows only the tables' names here (and "none").
+  if (options.measure_flow) StringToEnum(config.eval.flow, &options.flow.method);
+  StringToEnum(config.eval.flow_dis_preset, &options.flow.dis_preset);
   options.flow_in_all_cameras = config.eval.flow_cameras == "all";
   options.held_out_cameras = config.validation.cameras;
   options.held_out_score = config.validation.score;

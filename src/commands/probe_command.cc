@@ -87,8 +87,8 @@ int RunProbe(const Config& configured, int frame_index) {
   std::printf(
       "probe: frame %s, similarity %s (%s overlap), %d surface Gaussians, %ld pairs, "
       "RMS of k_true %.2f mm\n",
-      capture.frame_name(frame).c_str(), energy.options().similarity.c_str(),
-      energy.options().overlap.c_str(), energy.num_parameters(), energy.num_pairs(),
+      capture.frame_name(frame).c_str(), EnumToString(energy.options().similarity).c_str(),
+      EnumToString(energy.options().overlap).c_str(), energy.num_parameters(), energy.num_pairs(),
       1000.0 * std::sqrt(truth.squaredNorm() / std::max<long>(truth.size(), 1)));
   std::printf("%8s %16s %16s %16s\n", "alpha", "E", "E_sim", "E_reg");
   std::vector<ProbeSample> samples;
@@ -115,8 +115,8 @@ int RunProbe(const Config& configured, int frame_index) {
   normalise(&ProbeSample::similarity, &similarity);
   normalise(&ProbeSample::energy, &total);
   PlotOptions plot;
-  plot.title = "Energy along k = alpha k_true (" + energy.options().similarity + ", frame " +
-               capture.frame_name(frame) + ")";
+  plot.title = "Energy along k = alpha k_true (" + EnumToString(energy.options().similarity) +
+               ", frame " + capture.frame_name(frame) + ")";
   plot.x_label = "alpha (0 = input surface, 1 = true surface)";
   plot.y_label = "energy, scaled to [0, 1]";
   const std::string plot_path = out + "/probe_" + capture.frame_name(frame) + ".png";

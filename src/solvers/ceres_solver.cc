@@ -70,10 +70,10 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
                                   ? options.num_threads
                                   : static_cast<int>(std::thread::hardware_concurrency());
   ceres_options.trust_region_strategy_type =
-      options.trust_region == "dogleg" ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
-  if (options.linear_solver == "cgnr") {
+      options.trust_region == TrustRegionType::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+  if (options.linear_solver == LinearSolverType::kCgnr) {
     ceres_options.linear_solver_type = ceres::CGNR;
-  } else if (options.linear_solver == "dense_qr") {
+  } else if (options.linear_solver == LinearSolverType::kDenseQr) {
     ceres_options.linear_solver_type = ceres::DENSE_QR;
   } else {
     ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;

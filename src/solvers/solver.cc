@@ -5,7 +5,6 @@
 
 namespace finecap {
 
-
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
   SimilarityTerm& similarity = energy->similarity();
   similarity.PrepareResiduals(k, false);
@@ -31,12 +30,12 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   const double k_max = energy->options().k_max;
   *k = k->cwiseMax(-k_max).cwiseMin(k_max);
   SolverSummary summary;
-  summary.solver = options.type;
+  summary.solver = EnumToString(options.type);
   summary.ls_cost_start = LeastSquaresCost(energy, *k);
   summary.energy_start = energy->Evaluate(*k, nullptr);
-  if (options.type == "ceres") {
+  if (options.type == SolverType::kCeres) {
     internal::SolveWithCeres(energy, options, k, &summary);
-  } else if (options.type == "gradient_ascent") {
+  } else if (options.type == SolverType::kGradientAscent) {
     internal::SolveWithGradientAscent(*energy, options, k, &summary);
   } else {
     internal::SolveWithLbfgs(*energy, options, k, &summary);
