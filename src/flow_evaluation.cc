@@ -89,6 +89,18 @@ ProjectiveTexture MakeProjectiveTexture(const Mesh& mesh, const Eigen::Matrix3Xd
   return texture;
 }
 
+void FillUntexturedFaces(const ProjectiveTexture& fallback, ProjectiveTexture* texture) {
+  Require(fallback.textured.size() == texture->textured.size() &&
+              fallback.corner_uvs.cols() == texture->corner_uvs.cols() &&
+              fallback.atlas.size() == texture->atlas.size(),
+          kWhere, "the fallback texture was made for another mesh or other images");
+  for (size_t f = 0; f < texture->textured.size(); ++f) {
+    if (texture->textured[f] || !fallback.textured[f]) continue;
+    texture->textured[f] = 1;
+    texture->corner_uvs.middleCols<3>(3 * f) = fallback.corner_uvs.middleCols<3>(3 * f);
+  }
+}
+
 std::vector<unsigned char> FacesToMeasure(const Mesh& mesh, const ProjectiveTexture& texture,
                                           const std::vector<int>& vertex_ids) {
   Require(static_cast<int>(texture.textured.size()) == mesh.num_faces(), kWhere,
@@ -139,21 +151,25 @@ cv::Mat MeasuredPixels(const Camera& camera, const Mesh& mesh,
 }  // namespace
 
 FlowComparison CompareFlow(const Camera& camera, const cv::Mat& image, const Mesh& coarse,
-                           const Mesh& refined, const ProjectiveTexture& texture,
+                           const ProjectiveTexture& coarse_texture, const Mesh& refined,
+                           const ProjectiveTexture& refined_texture,
                            const std::vector<unsigned char>& faces_to_measure,
                            const OpticalFlowOptions& options, const std::string& where,
                            FlowFields* fields) {
   Require(image.cols == camera.width && image.rows == camera.height, where,
           "the image is not of camera " + camera.name + "'s size");
   Require(static_cast<int>(faces_to_measure.size()) == coarse.num_faces() &&
-              refined.num_faces() == coarse.num_faces(),
-          where, "the meshes and the faces to measure disagree in their face count");
+              refined.num_faces() == coarse.num_faces() &&
+              coarse_texture.textured.size() == faces_to_measure.size() &&
+              refined_texture.textured.size() == faces_to_measure.size(),
+          where,
+          "the meshes, their textures and the faces to measure disagree in their face count");
   const cv::Mat mask = MeasuredPixels(camera, coarse, faces_to_measure) |
                        MeasuredPixels(camera, refined, faces_to_measure);
   const cv::Mat coarse_flow = ComputeOpticalFlow(
-      RenderTexturedOverImage(camera, coarse, texture, image), image, options, where);
+      RenderTexturedOverImage(camera, coarse, coarse_texture, image), image, options, where);
   const cv::Mat refined_flow = ComputeOpticalFlow(
-      RenderTexturedOverImage(camera, refined, texture, image), image, options, where);
+      RenderTexturedOverImage(camera, refined, refined_texture, image), image, options, where);
   if (fields) *fields = FlowFields{mask, coarse_flow, refined_flow};
   return {SumFlowMagnitude(coarse_flow, mask, where), SumFlowMagnitude(refined_flow, mask, where)};
 }

@@ -103,15 +103,29 @@ std::string WriteFlowPicture(const FlowFields& fields, const cv::Mat& image, con
 // What the optical-flow figures need, prepared once per run from the reference frame.
 struct FlowSetup {
   OpticalFlowOptions options;
-  std::vector<int> cameras;  // The cameras the flow is measured in.
-  ProjectiveTexture texture;
+  std::vector<int> cameras;           // The cameras the flow is measured in.
+  ProjectiveTexture input_texture;    // From the reference frame's subdivided input mesh.
+  ProjectiveTexture refined_texture;  // From its refined mesh, or the input's (see source).
+  RefinedFlowTexture refined_texture_source = RefinedFlowTexture::kInputReferenceMesh;
   std::vector<unsigned char> faces_to_measure;
 };
 
-// The texture of the reference frame's subdivided input mesh from its images (see
-// flow_evaluation.h for why not the saved reference colours), over the faces of refined vertices.
+// The texture of `mesh`, a surface of the reference frame `reference`, from that frame's images,
+// with the camera choice and visibility of that surface.
+ProjectiveTexture TextureFromSurface(const Mesh& mesh, const FrameInput& reference,
+                                     const VisibilityOptions& visibility) {
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(mesh);
+  return MakeProjectiveTexture(
+      mesh, normals, reference.cameras, reference.images,
+      ComputeFrameVisibility(mesh, normals, reference.cameras, visibility));
+}
+
+// The textures of the reference frame's subdivided input mesh and of its refined mesh (when
+// `refined_reference` has it; else the input's paints both) from its images (see
+// flow_evaluation.h for why each its own, and why not the saved reference colours), over the
+// faces of refined vertices the input's texture covers.
 FlowSetup PrepareFlow(const RunEvaluationOptions& options, const SequenceModel& model,
-                      Capture* capture) {
+                      const std::optional<RefinedFrame>& refined_reference, Capture* capture) {
   FlowSetup setup;
   setup.options = options.flow;
   for (int c = 0; c < capture->num_cameras(); ++c) {
@@ -122,11 +136,19 @@ FlowSetup PrepareFlow(const RunEvaluationOptions& options, const SequenceModel& 
               capture->directory());
   const FrameInput reference = ReadFrameInput(capture, options.reference_frame);
   const Mesh fine = model.Subdivide(reference.coarse);
-  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  setup.texture = MakeProjectiveTexture(
-      fine, normals, reference.cameras, reference.images,
-      ComputeFrameVisibility(fine, normals, reference.cameras, options.refine.visibility));
-  setup.faces_to_measure = FacesToMeasure(fine, setup.texture, model.refined_vertices());
+  const VisibilityOptions& visibility = options.refine.visibility;
+  setup.input_texture = TextureFromSurface(fine, reference, visibility);
+  setup.faces_to_measure = FacesToMeasure(fine, setup.input_texture, model.refined_vertices());
+  setup.refined_texture = setup.input_texture;
+  if (!refined_reference) return setup;
+  Require(refined_reference->index == options.reference_frame, refined_reference->files.mesh,
+          "is not the refined mesh of the reference frame " +
+              capture->frame_name(options.reference_frame));
+  const Mesh refined = ReadMesh(refined_reference->files.mesh);
+  RequireSameTopology(fine, refined, refined_reference->files.mesh);
+  setup.refined_texture = TextureFromSurface(refined, reference, visibility);
+  FillUntexturedFaces(setup.input_texture, &setup.refined_texture);
+  setup.refined_texture_source = RefinedFlowTexture::kRefinedReferenceMesh;
   return setup;
 }
 
@@ -138,8 +160,9 @@ FlowComparison MeasureFrameFlow(const FlowSetup& setup, int frame, const Mesh& i
   FlowComparison frame_flow;
   for (int c : setup.cameras) {
     const Camera& camera = capture->cameras()[c];
-    frame_flow.Add(CompareFlow(camera, capture->ReadImage(c, frame), input, refined, setup.texture,
-                               setup.faces_to_measure, setup.options,
+    frame_flow.Add(CompareFlow(camera, capture->ReadImage(c, frame), input, setup.input_texture,
+                               refined, setup.refined_texture, setup.faces_to_measure,
+                               setup.options,
                                capture->directory() + ": flow in camera " + camera.name +
                                    ", frame " + capture->frame_name(frame),
                                c == eval_camera ? eval_fields : nullptr));
@@ -154,6 +177,7 @@ struct EvaluationRun {
   std::vector<EvaluationFigures> figures;
   std::vector<FlowComparison> flows;  // Per frame; empty sums when flow is not measured.
   FlowComparison pooled_flow;
+  std::optional<RefinedFlowTexture> refined_flow_texture;  // None when flow is not measured.
   std::vector<internal::HeldOutFrame> heldout;  // Per frame; empty without validation.cameras.
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
@@ -254,8 +278,11 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
-       << ",\n  " << FlowJson(run.pooled_flow, "\n  ") << ",\n  "
-       << internal::HeldOutPooledJson(run.heldout, "\n  ")
+       << ",\n  " << FlowJson(run.pooled_flow, "\n  ") << ",\n  \"flow_refined_texture\": "
+       << (run.refined_flow_texture
+               ? internal::JsonString(RefinedFlowTextureName(*run.refined_flow_texture))
+               : std::string("null"))
+       << ",\n  " << internal::HeldOutPooledJson(run.heldout, "\n  ")
        << ",\n  \"sequence\": " << FiguresJson(sequence) << ",\n  \"frames\": [";
   for (size_t i = 0; i < run.names.size(); ++i) {
     json << (i == 0 ? "\n    " : ",\n    ") << "{\"frame\": " << internal::JsonString(run.names[i])
@@ -357,6 +384,16 @@ void AddFlowTable(const EvaluationRun& run, HtmlReport* report) {
       "frame's images, to the input image, over the pixels where the model shows refined "
       "vertices (no ground truth needed; the paper's section 7). Improvement: 100 (input - "
       "refined) / input. n/a: not measured (eval.flow: none).");
+  if (run.refined_flow_texture == RefinedFlowTexture::kRefinedReferenceMesh) {
+    report->AddParagraph(
+        "Each mesh is textured from its own surface in the reference frame: the input mesh from "
+        "the reference frame's input mesh, the refined mesh from its refined mesh.");
+  } else if (run.refined_flow_texture == RefinedFlowTexture::kInputReferenceMesh) {
+    report->AddParagraph(
+        "The reference frame is not refined in this run folder: the texture of the reference "
+        "frame's input mesh paints both meshes, so wherever the input is wrong in the reference "
+        "frame the refined mesh's flow is overstated.");
+  }
   report->AddTable({"", "flow input px", "flow refined px", "improvement %"}, rows,
                    "Optical flow, the sequence pooled and per frame");
 }
@@ -443,6 +480,16 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
 
 }  // namespace
 
+const char* RefinedFlowTextureName(RefinedFlowTexture texture) {
+  switch (texture) {
+    case RefinedFlowTexture::kRefinedReferenceMesh:
+      return "refined_reference_mesh";
+    case RefinedFlowTexture::kInputReferenceMesh:
+      return "input_reference_mesh";
+  }
+  return "unknown";
+}
+
 void RunEvaluationOptions::Check() const {
   refine.Check();
   held_out_score.Check();
@@ -454,6 +501,7 @@ void RunEvaluationOptions::Check() const {
 }
 
 RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& frames,
+                          const std::optional<RefinedFrame>& refined_reference,
                           const RunEvaluationOptions& options, const std::string& folder,
                           EvaluationObserver* observer) {
   options.Check();
@@ -467,8 +515,13 @@ RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& fra
                             capture->directory() + "/meshes");
   const std::vector<int> textureless = model.SubdivideIds(capture->textureless_vertices());
   std::optional<FlowSetup> flow;
-  if (options.measure_flow) flow = PrepareFlow(options, model, capture);
+  if (options.measure_flow) {
+    flow = PrepareFlow(options, model, refined_reference, capture);
+    if (!refined_reference)
+      observer->RefinedReferenceUnavailable(capture->frame_name(options.reference_frame));
+  }
   EvaluationRun run;
+  if (flow) run.refined_flow_texture = flow->refined_texture_source;
   for (const RefinedFrame& frame : frames) {
     EvaluateFrame(frame, options, model, textureless, flow ? &*flow : nullptr, folder, capture,
                   &run);
@@ -478,6 +531,7 @@ RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& fra
   result.sequence = ComputeEvaluationFigures(run.pooled);
   result.flow_measured = flow.has_value();
   result.flow = run.pooled_flow;
+  result.refined_flow_texture = run.refined_flow_texture.value_or(result.refined_flow_texture);
   if (!run.heldout.empty()) result.heldout = internal::PooledHeldOutScore(run.heldout);
   result.metrics = folder + "/metrics.json";
   result.report = folder + "/report.html";

@@ -91,14 +91,24 @@ Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
 }
 
+std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,
+                                             const std::vector<std::string>& frame_names, int frame,
+                                             MeshFormat mesh_format) {
+  if (frame < 0 || frame >= static_cast<int>(frame_names.size())) return std::nullopt;
+  const FrameFiles files = FrameFilesIn(out, frame_names[frame], mesh_format);
+  if (!FrameDone(files)) return std::nullopt;
+  return RefinedFrame{frame, frame_names[frame], files};
+}
+
 std::vector<RefinedFrame> FindRefinedFrames(const std::string& out,
                                             const std::vector<std::string>& frame_names,
                                             const FrameRange& frames, MeshFormat mesh_format,
                                             const std::string& capture) {
   std::vector<RefinedFrame> done;
   for (int frame = frames.begin; frame < frames.end; ++frame) {
-    const FrameFiles files = FrameFilesIn(out, frame_names[frame], mesh_format);
-    if (FrameDone(files)) done.push_back({frame, frame_names[frame], files});
+    if (auto refined = FindRefinedFrame(out, frame_names, frame, mesh_format)) {
+      done.push_back(*refined);
+    }
   }
   Require(!done.empty(), out,
           "holds no refined run of the configured frames of " + capture + " (no meshes/<frame>." +

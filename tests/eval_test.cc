@@ -16,6 +16,8 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
+#include "finecap/run_folder.h"
+#include "finecap/sequence.h"
 #include "finecap/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
@@ -162,6 +164,8 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_NEAR(metrics["flow_improvement_percent"].as<double>(),
               100.0 * (flow_coarse - flow_refined) / flow_coarse, 1e-6);
   EXPECT_TRUE(std::isfinite(metrics["frames"][0]["flow_refined_px"].as<double>()));
+  // Frame 0, the reference frame, is refined: the refined mesh has its own texture.
+  EXPECT_EQ(metrics["flow_refined_texture"].as<std::string>(), "refined_reference_mesh");
   EXPECT_EQ(metrics["frames"].size(), 3u);
   EXPECT_DOUBLE_EQ(metrics["sequence"]["all"]["rms_coarse_mm"].as<double>(), rms_coarse);
 
@@ -210,6 +214,7 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   const YAML::Node unmeasured = YAML::LoadFile(out + "/eval/metrics.json");
   EXPECT_TRUE(unmeasured["flow_coarse_px"].IsNull());
   EXPECT_TRUE(unmeasured["flow_improvement_percent"].IsNull());
+  EXPECT_TRUE(unmeasured["flow_refined_texture"].IsNull());
   EXPECT_TRUE(unmeasured["frames"][1]["flow_refined_px"].IsNull());
 
   // The same run exported: one PC2 sample per frame holding the refined vertices.
@@ -220,6 +225,68 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   ASSERT_EQ(cache.header.num_points, last.num_vertices());
   EXPECT_LT((cache.samples.back().cast<double>() - last.vertices).cwiseAbs().maxCoeff(), 1e-6);
   EXPECT_EQ(testing_util::FilesIn(out + "/export/ply").size(), 3u);
+}
+
+// Writes the truth of every frame of `capture_dir` into the run folder `out` as if refinement had
+// found it: the subdivided input mesh moved along its normals by the true displacement.
+void WriteTruthAsRun(const std::string& capture_dir, const Config& config, const std::string& out) {
+  const Capture capture = Capture::Open(capture_dir);
+  const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
+                            capture_dir);
+  PrepareRunSubfolders(out);
+  for (int frame = 0; frame < capture.num_frames(); ++frame) {
+    const Mesh coarse = capture.ReadCoarseMesh(frame);
+    Mesh truth = model.Subdivide(coarse);
+    Eigen::VectorXd k = TrueFineDisplacement(capture, model, coarse, frame);
+    ASSERT_EQ(k.size(), truth.num_vertices());
+    k = k.array().isFinite().select(k, 0.0);
+    const Eigen::Matrix3Xd normals = ComputeVertexNormals(truth);
+    truth.vertices += normals * k.asDiagonal();
+    const FrameFiles files = FrameFilesIn(out, capture.frame_name(frame), MeshFormat::kPly);
+    WriteMesh(files.mesh, truth);
+    WriteDisplacement(files.displacement, k);
+    std::ofstream(files.stats) << "{}\n";
+  }
+}
+
+TEST(EvalCommandTest, FlowTexturesTheRefinedMeshFromItsOwnReferenceSurface) {
+  // Folds at full amplitude from frame 0, the reference frame: the input mesh is wrong there.
+  const std::string root = MakeTempDir("eval_flow_texture");
+  const std::string capture = root + "/capture";
+  const std::string out = root + "/truth";
+  // 6 cameras of 128 x 128: each face is seen by more than the camera that textures it, so a
+  // texture on a wrong surface shows as flow.
+  SynthOptions synth = testing_util::TinyRefinableSynthOptions(3);
+  synth.cameras.count = 6;
+  synth.cameras.width = 128;
+  synth.cameras.height = 128;
+  synth.cameras.focal = 400.0;
+  GenerateSyntheticCapture(synth, capture);
+  Config config = RunConfig(capture, out);
+  WriteTruthAsRun(capture, config, out);
+  config.capture.frames = "1:3";  // The later frames, where the texture has moved with the cloth.
+  ASSERT_EQ(RunEval(config), 0);
+  const YAML::Node own = YAML::LoadFile(out + "/eval/metrics.json");
+  EXPECT_EQ(own["flow_refined_texture"].as<std::string>(), "refined_reference_mesh");
+
+  // Without the refined reference frame the input's texture paints both meshes (the old rule).
+  fs::remove(FrameFilesIn(out, "000000", MeshFormat::kPly).stats);
+  ::testing::internal::CaptureStderr();
+  ASSERT_EQ(RunEval(config), 0);
+  const std::string warning = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(warning.find("reference frame 000000 is not refined"), std::string::npos) << warning;
+  const YAML::Node shared = YAML::LoadFile(out + "/eval/metrics.json");
+  EXPECT_EQ(shared["flow_refined_texture"].as<std::string>(), "input_reference_mesh");
+
+  // The input's figure does not depend on the refined mesh's texture.
+  const double input_px = own["flow_coarse_px"].as<double>();
+  EXPECT_EQ(input_px, shared["flow_coarse_px"].as<double>());
+  // The truth, textured from its own surface, flows clearly less than the input, and clearly
+  // less than when its texture was projected onto the input's wrong surface.
+  const double own_px = own["flow_refined_px"].as<double>();
+  const double shared_px = shared["flow_refined_px"].as<double>();
+  EXPECT_LT(own_px, 0.5 * input_px);
+  EXPECT_LT(own_px, 0.6 * shared_px);
 }
 
 TEST(EvalCommandTest, RefusesAFolderWithoutARefinedRun) {

@@ -179,7 +179,7 @@ TEST(FlowEvaluationTest, APlaneMovedSidewaysFlowsByItsImageShift) {
   std::vector<int> all(plane.num_vertices());
   for (int v = 0; v < plane.num_vertices(); ++v) all[v] = v;
   const FlowComparison flow =
-      CompareFlow(scene.camera, scene.image, moved, plane, scene.texture,
+      CompareFlow(scene.camera, scene.image, moved, scene.texture, plane, scene.texture,
                   FacesToMeasure(plane, scene.texture, all), OpticalFlowOptions(), "plane");
   // The union of both footprints is 53 px wide, 50 of which show the texture 3 px off.
   EXPECT_NEAR(flow.coarse.mean_px(), 3.0 * 50.0 / 53.0, 0.35);
@@ -203,6 +203,28 @@ TEST(FlowEvaluationTest, OnlyTexturedFacesOfChosenVerticesAreMeasured) {
   const std::vector<unsigned char> centre = FacesToMeasure(plane, texture, {4});
   EXPECT_EQ(std::count(centre.begin(), centre.end(), 1), 6);
   ExpectErrorMentions([&] { FacesToMeasure(plane, texture, {9}); }, {"out of range"});
+}
+
+TEST(FlowEvaluationTest, UntexturedFacesTakeTheFallbacksTexture) {
+  const Mesh plane = FacingPlane(1.0, 2.0, 2);  // 9 vertices, 8 faces.
+  const Camera camera = PinholeCamera(64, 50.0);
+  const cv::Mat image = RandomTexture(64, 64);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(plane);
+  std::vector<std::vector<unsigned char>> seen = {std::vector<unsigned char>(9, 1)};
+  const ProjectiveTexture fallback = MakeProjectiveTexture(plane, normals, {camera}, {image}, seen);
+  seen[0][8] = 0;  // Its one face (the last) goes untextured.
+  ProjectiveTexture texture = MakeProjectiveTexture(plane, normals, {camera}, {image}, seen);
+  ASSERT_FALSE(texture.textured[7]);
+  const Eigen::Matrix2Xd before = texture.corner_uvs;
+  FillUntexturedFaces(fallback, &texture);
+  EXPECT_EQ(texture.textured, fallback.textured);
+  EXPECT_EQ(texture.corner_uvs.rightCols<3>(), fallback.corner_uvs.rightCols<3>());
+  EXPECT_EQ(texture.corner_uvs.leftCols(21), before.leftCols(21));  // Textured faces keep theirs.
+  const Mesh other = FacingPlane(1.0, 2.0, 3);
+  const ProjectiveTexture wrong =
+      MakeProjectiveTexture(other, ComputeVertexNormals(other), {camera}, {image},
+                            {std::vector<unsigned char>(other.num_vertices(), 1)});
+  ExpectErrorMentions([&] { FillUntexturedFaces(wrong, &texture); }, {"another mesh"});
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #ifndef FINECAP_RUN_EVALUATION_H_
 #define FINECAP_RUN_EVALUATION_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,14 @@ struct RunEvaluationOptions {
   void Check() const;
 };
 
+// Which surface of the reference frame textured the refined mesh for the optical flow
+// (flow_evaluation.h): its own, the refined reference mesh, or (when the run folder holds no
+// refined reference frame) the subdivided input mesh, whose texture then paints both meshes.
+enum class RefinedFlowTexture { kRefinedReferenceMesh, kInputReferenceMesh };
+
+// "refined_reference_mesh" or "input_reference_mesh", as metrics.json names them.
+const char* RefinedFlowTextureName(RefinedFlowTexture texture);
+
 // What EvaluateRun tells its caller while it runs; every method does nothing unless overridden.
 class EvaluationObserver {
  public:
@@ -48,22 +57,31 @@ class EvaluationObserver {
   virtual void FrameEvaluated(const std::string& /*frame*/) {}
   // three.js was not found (mesh_viewer.h): the report has a note in place of its 3D view.
   virtual void ViewerUnavailable() {}
+  // The reference frame `frame` is not refined in the run folder: the flow paints the refined
+  // mesh with the input's texture (RefinedFlowTexture::kInputReferenceMesh). Called once.
+  virtual void RefinedReferenceUnavailable(const std::string& /*frame*/) {}
 };
 
 // The headline figures of an evaluated run, and where its files are.
 struct RunEvaluation {
   EvaluationFigures sequence;  // Every frame's vertices pooled.
   bool flow_measured = false;
+  // What textured the refined mesh for the flow, when measured.
+  RefinedFlowTexture refined_flow_texture = RefinedFlowTexture::kInputReferenceMesh;
   FlowComparison flow;                // Pooled over the frames and cameras.
   std::vector<SurfaceScore> heldout;  // Input, refined; empty without held-out cameras.
   std::string report, metrics;        // report.html and metrics.json.
 };
 
 // Evaluates `frames` of `capture` (the done frames of a run folder: FindRefinedFrames) into
-// `folder` (created when missing; EvalFolder of the run folder). Throws Error naming the file or
-// the option when an input cannot be read or `options` are invalid (Check()). `observer` may be
-// null.
+// `folder` (created when missing; EvalFolder of the run folder). `refined_reference` is the run
+// folder's reference frame (options.reference_frame) when it is done there (FindRefinedFrame),
+// whether or not it is among `frames`: its refined mesh textures the refined mesh for the flow;
+// without it the input's texture paints both and the observer hears of it. Throws Error naming
+// the file or the option when an input cannot be read or `options` are invalid (Check()).
+// `observer` may be null.
 RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& frames,
+                          const std::optional<RefinedFrame>& refined_reference,
                           const RunEvaluationOptions& options, const std::string& folder,
                           EvaluationObserver* observer = nullptr);
 

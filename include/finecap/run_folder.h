@@ -17,6 +17,7 @@
 #ifndef FINECAP_RUN_FOLDER_H_
 #define FINECAP_RUN_FOLDER_H_
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,12 @@ std::vector<RefinedFrame> FindRefinedFrames(const std::string& out,
                                             const std::vector<std::string>& frame_names,
                                             const FrameRange& frames, MeshFormat mesh_format,
                                             const std::string& capture);
+
+// Frame `frame` (an index into `frame_names`, the capture's sorted frames) of `out` when it is
+// done there; nullopt otherwise (also when `frame` is not one of them).
+std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,
+                                             const std::vector<std::string>& frame_names, int frame,
+                                             MeshFormat mesh_format);
 
 // Creates the subfolders of a run folder and removes the temporaries that killed runs left in
 // it (RemoveStaleTemporaries); returns how many were removed.

@@ -3,6 +3,7 @@
 // output.dir/eval/ (run_evaluation.h).
 #include <cmath>
 #include <iostream>
+#include <optional>
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
@@ -35,6 +36,11 @@ class ConsoleObserver : public EvaluationObserver {
   void ViewerUnavailable() override {
     std::cerr << "finecap eval: warning: three.js not found (install Debian's libjs-three or set "
                  "FINECAP_THREE_JS_DIR); report.html has a note in place of the 3D view\n";
+  }
+  void RefinedReferenceUnavailable(const std::string& frame) override {
+    std::cerr << "finecap eval: warning: the reference frame " << frame
+              << " is not refined in this run folder; the optical flow paints the refined mesh "
+                 "with the input's texture (metrics.json: flow_refined_texture)\n";
   }
 
  private:
@@ -74,9 +80,11 @@ int RunEval(const Config& configured) {
           std::to_string(config.eval.camera) + " is not a camera of " + capture.directory() +
               ", which has " + std::to_string(capture.num_cameras()));
   const std::vector<RefinedFrame> frames = internal::FindRefinedFrames(config, capture, out);
+  const std::optional<RefinedFrame> reference = FindRefinedFrame(
+      out, capture.frame_names(), config.reference_frame, internal::MeshFormatOf(config));
   ConsoleObserver observer(frames.size());
-  PrintFigures(
-      EvaluateRun(&capture, frames, EvaluationOptionsOf(config), EvalFolder(out), &observer));
+  PrintFigures(EvaluateRun(&capture, frames, reference, EvaluationOptionsOf(config),
+                           EvalFolder(out), &observer));
   return 0;
 }
 
