@@ -8,7 +8,7 @@
 #include <omp.h>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/color.h"
+#include "finecap/geometry/color.h"
 #include "finecap/image_gaussians.h"
 
 namespace finecap {

@@ -7,7 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "../tests/test_meshes.h"
-#include "finecap/render.h"
+#include "finecap/geometry/render.h"
 
 namespace finecap {
 namespace {

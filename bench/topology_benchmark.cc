@@ -3,9 +3,9 @@
 #include <benchmark/benchmark.h>
 
 #include "../tests/test_meshes.h"
-#include "finecap/mesh_diagnostics.h"
-#include "finecap/neighbourhood.h"
-#include "finecap/subdivision.h"
+#include "finecap/geometry/mesh_diagnostics.h"
+#include "finecap/geometry/neighbourhood.h"
+#include "finecap/geometry/subdivision.h"
 
 namespace finecap {
 namespace {

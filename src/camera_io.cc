@@ -5,8 +5,8 @@
 #include <cctype>
 #include <filesystem>
 
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

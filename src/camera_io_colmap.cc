@@ -7,8 +7,8 @@
 #include <Eigen/Geometry>
 
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

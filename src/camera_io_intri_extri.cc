@@ -8,9 +8,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "camera_io_util.h"
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -4,10 +4,11 @@
 #include <cmath>
 #include <iostream>
 
+#include "camera_io_util.h"
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
 #include "toml_subset.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

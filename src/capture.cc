@@ -8,10 +8,10 @@
 #include <sstream>
 
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
 #include "finecap/mesh_io.h"
+#include "finecap/util/error.h"
 #include "finecap/vertex_mask.h"
-#include "io_util.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -5,8 +5,8 @@
 #include <limits>
 #include <sstream>
 
-#include "finecap/error.h"
 #include "finecap/metrics.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

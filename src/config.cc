@@ -4,9 +4,9 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "finecap/error.h"
 #include "finecap/optical_flow.h"
 #include "finecap/scene_scale.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

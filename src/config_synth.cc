@@ -14,7 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/config.h"
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "finecap/error.h"
 #include "finecap/surface_color_similarity.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

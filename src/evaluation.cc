@@ -4,7 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <cstring>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
 #include "finecap/mesh_io.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

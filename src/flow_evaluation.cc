@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
-#include "finecap/error.h"
-#include "finecap/render.h"
+#include "finecap/geometry/render.h"
+#include "finecap/util/error.h"
 #include "finecap/visibility.h"
 
 namespace finecap {

@@ -1,10 +1,10 @@
 #include "finecap/frame_energy.h"
 
 #include "finecap/consensus_similarity.h"
-#include "finecap/error.h"
 #include "finecap/input_prior.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cctype>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

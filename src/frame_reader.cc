@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 

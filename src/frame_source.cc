@@ -10,8 +10,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

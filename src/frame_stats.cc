@@ -7,9 +7,9 @@
 #include <limits>
 #include <sstream>
 
-#include "finecap/error.h"
-#include "flat_json.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/flat_json.h"
+#include "util/io_util.h"
 
 namespace finecap {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include "finecap/mesh_ray_caster.h"
+#include "finecap/geometry/mesh_ray_caster.h"
 
 namespace finecap {
 

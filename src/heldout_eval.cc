@@ -6,7 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "finecap/frame_reader.h"
-#include "io_util.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace internal {

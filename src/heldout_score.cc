@@ -9,8 +9,8 @@
 #include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/error.h"
-#include "finecap/render.h"
+#include "finecap/geometry/render.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

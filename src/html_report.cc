@@ -7,9 +7,9 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -6,7 +6,7 @@
 #include <cstring>
 #include <exception>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "option_checks.h"
 
 namespace finecap {

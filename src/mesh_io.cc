@@ -8,10 +8,10 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 #include "mesh_io_internal.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace internal {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 #include "finecap/mesh_io.h"
 
 namespace finecap {

@@ -2,9 +2,9 @@
 #include <set>
 #include <sstream>
 
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
 #include "mesh_io_internal.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace internal {

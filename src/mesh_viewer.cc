@@ -9,9 +9,9 @@
 #include <limits>
 #include <sstream>
 
-#include "finecap/error.h"
 #include "finecap/html_report.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -7,7 +7,7 @@
 #include <opencv2/optflow.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "option_checks.h"
 
 namespace finecap {

@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
-#include "finecap/enum_names.h"
-#include "finecap/error.h"
+#include "finecap/util/enum_names.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace internal {

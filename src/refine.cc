@@ -6,9 +6,9 @@
 #include <functional>
 
 #include "finecap/consensus_similarity.h"
-#include "finecap/error.h"
 #include "finecap/frame_energy.h"
-#include "finecap/render.h"
+#include "finecap/geometry/render.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

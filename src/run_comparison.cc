@@ -2,14 +2,14 @@
 
 #include <filesystem>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
 #include "finecap/frame_reader.h"
 #include "finecap/html_report.h"
-#include "finecap/plot.h"
 #include "finecap/run_folder.h"
 #include "finecap/solver_trace.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "finecap/util/plot.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

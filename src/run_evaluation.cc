@@ -8,17 +8,17 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
 #include "finecap/frame_reader.h"
+#include "finecap/geometry/render.h"
 #include "finecap/html_report.h"
 #include "finecap/mesh_io.h"
 #include "finecap/mesh_viewer.h"
-#include "finecap/plot.h"
-#include "finecap/render.h"
 #include "finecap/sequence.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "finecap/util/plot.h"
 #include "heldout_eval.h"
-#include "io_util.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

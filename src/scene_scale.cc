@@ -6,9 +6,9 @@
 #include <sstream>
 
 #include "finecap/capture.h"
-#include "finecap/error.h"
-#include "finecap/mesh_edges.h"
-#include "finecap/subdivision.h"
+#include "finecap/geometry/mesh_edges.h"
+#include "finecap/geometry/subdivision.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -5,11 +5,11 @@
 #include <filesystem>
 #include <sstream>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
 #include "finecap/ground_truth.h"
 #include "finecap/metrics.h"
 #include "finecap/solver_trace.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -5,10 +5,10 @@
 #include <iomanip>
 #include <sstream>
 
-#include "finecap/atomic_file.h"
-#include "finecap/error.h"
 #include "finecap/surface_color_similarity.h"
 #include "finecap/surface_projection.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 #include "finecap/visibility.h"
 
 namespace finecap {

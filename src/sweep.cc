@@ -2,10 +2,9 @@
 
 #include <vector>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
-
 
 namespace {
 

@@ -15,14 +15,14 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/atomic_file.h"
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
+#include "finecap/geometry/mesh_ray_caster.h"
+#include "finecap/geometry/mesh_smoothing.h"
 #include "finecap/mesh_io.h"
-#include "finecap/mesh_ray_caster.h"
-#include "finecap/mesh_smoothing.h"
-#include "io_util.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 #include "synth_internal.h"
+#include "util/io_util.h"
 
 namespace finecap {
 namespace {

@@ -8,8 +8,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "finecap/error.h"
 #include "finecap/mesh_io.h"
+#include "finecap/util/error.h"
 #include "synth_internal.h"
 
 namespace finecap {

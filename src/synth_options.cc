@@ -4,9 +4,9 @@
 #include <cmath>
 #include <string>
 
-#include "finecap/error.h"
-#include "finecap/mesh_smoothing.h"
+#include "finecap/geometry/mesh_smoothing.h"
 #include "finecap/synth.h"
+#include "finecap/util/error.h"
 #include "option_checks.h"
 
 namespace finecap {

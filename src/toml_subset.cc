@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <set>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace internal {

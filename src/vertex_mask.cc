@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <sstream>
 
-#include "finecap/error.h"
-#include "io_util.h"
+#include "finecap/util/error.h"
+#include "util/io_util.h"
 
 namespace finecap {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "option_checks.h"
 
 namespace finecap {

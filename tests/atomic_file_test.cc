@@ -1,6 +1,6 @@
 // Temporaries of the atomic writes: named after their writer, and removed only when that writer,
 // a process of this host, no longer runs.
-#include "finecap/atomic_file.h"
+#include "finecap/util/atomic_file.h"
 
 #include <sys/wait.h>
 #include <unistd.h>

@@ -10,7 +10,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

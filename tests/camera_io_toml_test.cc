@@ -10,8 +10,8 @@
 
 #include "finecap/camera_io.h"
 #include "finecap/capture.h"
-#include "finecap/error.h"
 #include "finecap/synth.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

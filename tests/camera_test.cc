@@ -1,4 +1,4 @@
-#include "finecap/camera.h"
+#include "finecap/geometry/camera.h"
 
 #include <cmath>
 #include <random>
@@ -8,7 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

@@ -10,8 +10,8 @@
 #include <opencv2/videoio.hpp>
 
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
 #include "finecap/mesh_io.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

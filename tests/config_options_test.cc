@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "finecap/config.h"
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

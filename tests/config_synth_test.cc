@@ -12,7 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/config.h"
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "finecap/frame_energy.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

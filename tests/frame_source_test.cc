@@ -8,7 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

@@ -12,10 +12,10 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/error.h"
 #include "finecap/frame_stats.h"
 #include "finecap/synth.h"
-#include "finecap/threads.h"
+#include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

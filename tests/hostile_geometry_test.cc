@@ -11,7 +11,7 @@
 #include "finecap/commands.h"
 #include "finecap/frame_reader.h"
 #include "finecap/frame_stats.h"
-#include "finecap/mesh_diagnostics.h"
+#include "finecap/geometry/mesh_diagnostics.h"
 #include "finecap/mesh_io.h"
 #include "finecap/refine.h"
 #include "finecap/scene_scale.h"

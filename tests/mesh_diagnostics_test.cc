@@ -1,8 +1,8 @@
-#include "finecap/mesh_diagnostics.h"
+#include "finecap/geometry/mesh_diagnostics.h"
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 
 namespace finecap {

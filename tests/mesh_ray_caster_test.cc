@@ -1,11 +1,11 @@
-#include "finecap/mesh_ray_caster.h"
+#include "finecap/geometry/mesh_ray_caster.h"
 
 #include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

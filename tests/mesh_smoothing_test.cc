@@ -1,12 +1,12 @@
 // Taubin smoothing: bumps fade, the shape keeps its size, vertices stay where they were on the
 // surface (little tangential drift), the topology is untouched, and bad strengths are refused.
-#include "finecap/mesh_smoothing.h"
+#include "finecap/geometry/mesh_smoothing.h"
 
 #include <cmath>
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 #include "test_util.h"
 

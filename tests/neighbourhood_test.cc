@@ -1,11 +1,11 @@
-#include "finecap/neighbourhood.h"
+#include "finecap/geometry/neighbourhood.h"
 
 #include <algorithm>
 #include <cstdlib>
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 
 namespace finecap {

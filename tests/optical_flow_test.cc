@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/error.h"
 #include "finecap/flow_evaluation.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 
 namespace finecap {

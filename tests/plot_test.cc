@@ -1,4 +1,4 @@
-#include "finecap/plot.h"
+#include "finecap/util/plot.h"
 
 #include <filesystem>
 #include <limits>

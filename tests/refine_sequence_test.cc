@@ -9,12 +9,12 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/atomic_file.h"
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/error.h"
 #include "finecap/frame_stats.h"
 #include "finecap/synth.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

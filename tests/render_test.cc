@@ -1,4 +1,4 @@
-#include "finecap/render.h"
+#include "finecap/geometry/render.h"
 
 #include <cmath>
 #include <limits>
@@ -9,7 +9,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 
 namespace finecap {

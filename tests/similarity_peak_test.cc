@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "energy_fixture.h"
+#include "finecap/geometry/render.h"
 #include "finecap/refine.h"
-#include "finecap/render.h"
 
 namespace finecap {
 namespace {

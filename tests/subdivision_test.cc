@@ -1,12 +1,12 @@
-#include "finecap/subdivision.h"
+#include "finecap/geometry/subdivision.h"
 
 #include <random>
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include "finecap/error.h"
-#include "finecap/mesh_edges.h"
+#include "finecap/geometry/mesh_edges.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 
 namespace finecap {

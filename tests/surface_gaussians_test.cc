@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "finecap/visibility.h"
 
 namespace finecap {

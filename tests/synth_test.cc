@@ -13,11 +13,11 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "finecap/atomic_file.h"
 #include "finecap/camera_io.h"
-#include "finecap/error.h"
+#include "finecap/geometry/render.h"
 #include "finecap/mesh_io.h"
-#include "finecap/render.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
 #include "test_meshes.h"
 #include "tiny_synth.h"
 

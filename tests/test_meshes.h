@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 namespace testing_meshes {

@@ -14,8 +14,8 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
-#include "finecap/threads.h"
+#include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 
 namespace finecap {
 namespace testing_util {

@@ -1,10 +1,10 @@
-#include "finecap/threads.h"
+#include "finecap/util/threads.h"
 
 #include <omp.h>
 
 #include <gtest/gtest.h>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

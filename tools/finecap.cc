@@ -15,8 +15,8 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/error.h"
-#include "finecap/threads.h"
+#include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 
 DECLARE_bool(help);
 

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "finecap/camera.h"
+#include "finecap/geometry/camera.h"
 
 namespace finecap {
 

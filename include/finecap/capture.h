@@ -25,9 +25,9 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
 #include "finecap/frame_source.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

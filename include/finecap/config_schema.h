@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "finecap/enum_names.h"
+#include "finecap/util/enum_names.h"
 
 namespace YAML {
 class Node;

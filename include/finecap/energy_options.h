@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "finecap/enum_names.h"
 #include "finecap/gaussian_overlap.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 #include "finecap/metrics.h"
 
 namespace finecap {

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

@@ -30,8 +30,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
 #include "finecap/optical_flow.h"
 
 namespace finecap {

@@ -13,7 +13,7 @@
 
 #include "finecap/energy_options.h"
 #include "finecap/gaussian_pairs.h"
-#include "finecap/neighbourhood.h"
+#include "finecap/geometry/neighbourhood.h"
 #include "finecap/regularizer.h"
 #include "finecap/similarity.h"
 #include "finecap/surface_gaussians.h"

@@ -13,7 +13,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
+#include "finecap/geometry/camera.h"
 
 namespace finecap {
 

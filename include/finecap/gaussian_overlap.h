@@ -19,7 +19,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/enum_names.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "finecap/camera.h"
+#include "finecap/geometry/camera.h"
 #include "finecap/image_gaussians.h"
 #include "finecap/surface_gaussians.h"
 

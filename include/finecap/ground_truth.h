@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/mesh.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

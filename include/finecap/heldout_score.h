@@ -36,8 +36,8 @@
 
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

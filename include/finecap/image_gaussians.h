@@ -4,7 +4,7 @@
 // Conventions. Pixel centres lie at integer coordinates, the top-left pixel's at (0, 0). A square
 // covering the pixels [x0, x0 + w) x [y0, y0 + w) becomes a Gaussian with mean
 // (x0 + (w - 1) / 2, y0 + (w - 1) / 2), standard deviation w / 2 pixels, and colour the mean of
-// the embedded colours of its pixels (finecap/color.h: convert, then average).
+// the embedded colours of its pixels (finecap/geometry/color.h: convert, then average).
 //
 // The quad-tree. The image is tiled from (0, 0) by root squares of side
 // RootSide() = min_leaf_size * 2^max_depth (1024 px by default, so a 1004 x 1004 image has one
@@ -34,13 +34,13 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/color.h"
+#include "finecap/geometry/color.h"
 
 namespace finecap {
 
 // How images are cut into image Gaussians.
 struct ImageGaussianOptions {
-  // Space in which colours are averaged and compared (finecap/color.h). Default: kHsv, the
+  // Space in which colours are averaged and compared (finecap/geometry/color.h). Default: kHsv, the
   // paper's choice.
   ColorSpace color_space = ColorSpace::kHsv;
 

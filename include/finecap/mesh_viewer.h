@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "finecap/camera.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
 
 namespace finecap {
 

@@ -13,7 +13,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "finecap/enum_names.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

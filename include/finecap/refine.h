@@ -15,17 +15,17 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
 #include "finecap/energy_options.h"
-#include "finecap/enum_names.h"
 #include "finecap/frame_energy.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
+#include "finecap/geometry/neighbourhood.h"
+#include "finecap/geometry/subdivision.h"
 #include "finecap/image_gaussians.h"
-#include "finecap/mesh.h"
-#include "finecap/neighbourhood.h"
 #include "finecap/solver.h"
-#include "finecap/subdivision.h"
 #include "finecap/surface_gaussians.h"
 #include "finecap/sweep.h"
+#include "finecap/util/enum_names.h"
 #include "finecap/visibility.h"
 
 namespace finecap {

@@ -14,7 +14,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/neighbourhood.h"
+#include "finecap/geometry/neighbourhood.h"
 
 namespace finecap {
 

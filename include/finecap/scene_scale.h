@@ -29,8 +29,8 @@
 #include <string>
 #include <vector>
 
-#include "finecap/camera.h"
-#include "finecap/mesh.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
 #include "finecap/refine.h"
 
 namespace finecap {

@@ -12,8 +12,8 @@
 
 #include <Eigen/Core>
 
-#include "finecap/camera.h"
 #include "finecap/gaussian_pairs.h"
+#include "finecap/geometry/camera.h"
 #include "finecap/image_gaussians.h"
 
 namespace finecap {

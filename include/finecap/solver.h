@@ -18,8 +18,8 @@
 
 #include <Eigen/Core>
 
-#include "finecap/enum_names.h"
 #include "finecap/frame_energy.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

@@ -10,11 +10,11 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
-#include "finecap/color.h"
-#include "finecap/enum_names.h"
 #include "finecap/gaussian_overlap.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/color.h"
 #include "finecap/image_gaussians.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

@@ -5,8 +5,8 @@
 
 #include <Eigen/Core>
 
-#include "finecap/camera.h"
 #include "finecap/gaussian_overlap.h"
+#include "finecap/geometry/camera.h"
 
 namespace finecap {
 

@@ -27,11 +27,11 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
-#include "finecap/enum_names.h"
-#include "finecap/mesh.h"
-#include "finecap/mesh_smoothing.h"
-#include "finecap/render.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
+#include "finecap/geometry/mesh_smoothing.h"
+#include "finecap/geometry/render.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
 

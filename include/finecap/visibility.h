@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera.h"
+#include "finecap/geometry/camera.h"
 
 namespace finecap {
 

@@ -9,8 +9,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "finecap/error.h"
 #include "finecap/mesh_io.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace internal {

@@ -5,9 +5,9 @@
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
-#include "finecap/error.h"
 #include "finecap/run_comparison.h"
-#include "finecap/threads.h"
+#include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 
 namespace finecap {
 namespace {

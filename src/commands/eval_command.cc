@@ -7,8 +7,8 @@
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
-#include "finecap/error.h"
 #include "finecap/run_evaluation.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {

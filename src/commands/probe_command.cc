@@ -11,8 +11,8 @@
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
-#include "finecap/error.h"
-#include "finecap/plot.h"
+#include "finecap/util/error.h"
+#include "finecap/util/plot.h"
 
 namespace finecap {
 namespace {

@@ -2,8 +2,8 @@
 #include <iostream>
 
 #include "finecap/commands.h"
-#include "finecap/error.h"
 #include "finecap/synth.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 

@@ -1,6 +1,6 @@
 #include "finecap/solver.h"
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 #include "solvers/solvers_internal.h"
 
 namespace finecap {

@@ -16,7 +16,7 @@
 #include <string>
 #include <utility>
 
-#include "finecap/error.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace fuzz {

@@ -1,0 +1,77 @@
+// Loop subdivision as a fixed linear map. Because Loop's rules depend on the connectivity only,
+// the subdivision of a sequence that shares one topology is a single sparse matrix S
+// (fine vertices x coarse vertices): every frame's fine vertices are coarse.vertices * S^T, and
+// every subdivided frame shares the fine faces, i.e. one topology again.
+//
+// Rules (Loop 1987, with the usual crease rules on the boundary of an open mesh):
+//  * interior vertex of valence n: (1 - n * beta) * v + beta * (sum of its n neighbours), with
+//    Loop's original beta(n) = (5/8 - (3/8 + 1/4 * cos(2 * pi / n))^2) / n (1/16 when n = 6, so a
+//    regular vertex keeps 5/8 of itself and takes 1/16 of each neighbour);
+//  * boundary vertex (on exactly two boundary edges): 3/4 * v + 1/8 * each boundary neighbour, so
+//    an open boundary (a skirt's hem) is subdivided as a cubic B-spline curve of its own;
+//  * interior edge (a, b) with opposite vertices c, d: 3/8 * (a + b) + 1/8 * (c + d);
+//  * boundary edge (a, b): 1/2 * (a + b);
+//  * a vertex on more than two boundary edges (where two sheets touch at a point) and a vertex in
+//    no triangle keep their position.
+// Corners are not tagged: a boundary vertex where the boundary turns sharply is smoothed like any
+// other and rounds the corner (a closed hem, like a skirt's, has none).
+// Every row of S sums to 1, so the map is affine-invariant: planes stay planar.
+//
+// Vertex numbering, an invariant other code relies on: the first num_coarse_vertices fine
+// vertices are the coarse vertices, in order; then come the edge points of each level in the edge
+// order of MeshEdges (edges sorted by their vertex pair). Each coarse triangle (a, b, c) becomes
+// four fine triangles with its orientation: (a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca).
+#ifndef FINECAP_GEOMETRY_SUBDIVISION_H_
+#define FINECAP_GEOMETRY_SUBDIVISION_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "finecap/geometry/mesh.h"
+
+namespace finecap {
+
+struct SubdivisionStencil {
+  // S: num_fine_vertices x num_coarse_vertices; row i holds the weights of fine vertex i. For
+  // several levels it is the product S_levels * ... * S_1.
+  Eigen::SparseMatrix<double> matrix;
+  Eigen::Matrix3Xi faces;  // Fine triangles, oriented as their coarse triangles.
+  int num_coarse_vertices = 0;
+  int levels = 0;
+  // level_edges[l](:, e) are the two parents of the edge point num_vertices_before(l) + e, as
+  // vertex ids of level l's input mesh (level 0 is the coarse mesh).
+  std::vector<Eigen::Matrix2Xi> level_edges;
+
+  int num_fine_vertices() const { return static_cast<int>(matrix.rows()); }
+  // The fine vertex that sits where coarse vertex `coarse_vertex` does: the same id, by the
+  // numbering invariant above. Throws Error when the id is out of range.
+  int FineVertexOfCoarse(int coarse_vertex) const;
+};
+
+// Builds S and the fine faces for `levels` rounds of Loop subdivision (0 gives the identity and
+// the coarse faces). Uses the connectivity of `coarse` only. Throws Error(where, ...) when the
+// mesh fails Mesh::Validate, when levels is negative or would overflow the vertex ids, or when an
+// edge is in three or more triangles (non-manifold: Loop's rules are undefined there).
+SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels,
+                                        const std::string& where = "mesh");
+
+// The fine mesh of one frame: vertices coarse_vertices * S^T, faces the stencil's. Throws
+// Error(where, ...) when coarse_vertices has not num_coarse_vertices columns; `where` names the
+// frame's file.
+Mesh ApplySubdivision(const SubdivisionStencil& stencil, const Eigen::Matrix3Xd& coarse_vertices,
+                      const std::string& where = "subdivision");
+
+// Carries a per-vertex mask (e.g. the vertices to refine) to the fine mesh: a coarse vertex keeps
+// its flag and an edge point is in the mask exactly when both of its parents are, level by level.
+// Throws Error(where, ...) when the mask has not num_coarse_vertices entries; `where` names the
+// mask's file.
+std::vector<bool> SubdivideVertexMask(const SubdivisionStencil& stencil,
+                                      const std::vector<bool>& coarse_mask,
+                                      const std::string& where = "subdivision");
+
+}  // namespace finecap
+
+#endif  // FINECAP_GEOMETRY_SUBDIVISION_H_
