@@ -3,8 +3,8 @@
 #include <cmath>
 #include <limits>
 
-#include "finecap/util/error.h"
 #include "finecap/geometry/mesh_edges.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
