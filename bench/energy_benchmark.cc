@@ -15,9 +15,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "finecap/capture.h"
 #include "finecap/config.h"
 #include "finecap/frame_reader.h"
+#include "finecap/io/capture.h"
 #include "finecap/refine.h"
 
 namespace finecap {

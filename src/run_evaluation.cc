@@ -11,7 +11,7 @@
 #include "finecap/frame_reader.h"
 #include "finecap/geometry/render.h"
 #include "finecap/html_report.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/mesh_viewer.h"
 #include "finecap/sequence.h"
 #include "finecap/util/atomic_file.h"

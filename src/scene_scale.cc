@@ -5,9 +5,9 @@
 #include <iomanip>
 #include <sstream>
 
-#include "finecap/capture.h"
 #include "finecap/geometry/mesh_edges.h"
 #include "finecap/geometry/subdivision.h"
+#include "finecap/io/capture.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

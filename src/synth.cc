@@ -15,10 +15,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/camera_io.h"
 #include "finecap/geometry/mesh_ray_caster.h"
 #include "finecap/geometry/mesh_smoothing.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 #include "synth_internal.h"

@@ -8,7 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/error.h"
 #include "synth_internal.h"
 

@@ -1,4 +1,4 @@
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 
 #include <cmath>
 #include <cstdlib>

@@ -8,8 +8,8 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "finecap/camera_io.h"
-#include "finecap/capture.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/capture.h"
 #include "finecap/synth.h"
 #include "finecap/util/error.h"
 #include "test_util.h"

@@ -1,4 +1,4 @@
-#include "finecap/capture.h"
+#include "finecap/io/capture.h"
 
 #include <cmath>
 #include <filesystem>
@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "finecap/camera_io.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 

@@ -1,8 +1,8 @@
 // finecap eval: the figures of the evaluation against independent computations, and the whole
 // command on a tiny refined synthetic run (metrics.json, pictures, report), plus its bad input.
 #include "finecap/evaluation.h"
-#include "finecap/export.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/export.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/mesh_viewer.h"
 
 #include <cmath>

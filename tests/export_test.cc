@@ -1,4 +1,4 @@
-#include "finecap/export.h"
+#include "finecap/io/export.h"
 
 #include <cstdint>
 #include <cstring>
@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "test_util.h"
 
 namespace finecap {

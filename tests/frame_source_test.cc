@@ -1,4 +1,4 @@
-#include "finecap/frame_source.h"
+#include "finecap/io/frame_source.h"
 
 #include <cmath>
 #include <filesystem>

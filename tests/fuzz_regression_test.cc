@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/camera_io.h"
 #include "finecap/config.h"
+#include "finecap/io/camera_io.h"
 #include "test_util.h"
 
 namespace finecap {

@@ -6,13 +6,13 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/camera_io.h"
-#include "finecap/capture.h"
 #include "finecap/commands.h"
 #include "finecap/frame_reader.h"
 #include "finecap/frame_stats.h"
 #include "finecap/geometry/mesh_diagnostics.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/capture.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/refine.h"
 #include "finecap/scene_scale.h"
 #include "finecap/synth.h"

@@ -1,4 +1,4 @@
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 
 #include <cmath>
 #include <cstdint>

@@ -5,9 +5,9 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/capture.h"
 #include "finecap/frame_energy.h"
 #include "finecap/gaussian_pairs.h"
+#include "finecap/io/capture.h"
 #include "finecap/scene_scale.h"
 #include "finecap/synth.h"
 #include "test_util.h"

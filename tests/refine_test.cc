@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/capture.h"
 #include "finecap/frame_reader.h"
+#include "finecap/io/capture.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

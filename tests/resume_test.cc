@@ -20,7 +20,7 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/capture.h"
+#include "finecap/io/capture.h"
 #include "test_meshes.h"
 
 namespace finecap {

@@ -14,7 +14,7 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/synth.h"
 #include "test_meshes.h"
 #include "test_util.h"

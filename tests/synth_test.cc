@@ -13,9 +13,9 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "finecap/camera_io.h"
 #include "finecap/geometry/render.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 #include "test_meshes.h"

@@ -10,8 +10,8 @@
 
 #include "finecap/compare_config.h"
 #include "finecap/config_schema.h"
-#include "finecap/frame_range.h"
 #include "finecap/heldout_score.h"
+#include "finecap/io/frame_range.h"
 #include "finecap/refine.h"
 #include "finecap/shard.h"
 #include "finecap/synth.h"

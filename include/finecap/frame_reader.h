@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "finecap/capture.h"
 #include "finecap/heldout_score.h"
+#include "finecap/io/capture.h"
 #include "finecap/refine.h"
 
 namespace finecap {

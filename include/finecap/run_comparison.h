@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "finecap/capture.h"
 #include "finecap/comparison.h"
-#include "finecap/frame_range.h"
+#include "finecap/io/capture.h"
+#include "finecap/io/frame_range.h"
 #include "finecap/sequence.h"
 
 namespace finecap {

@@ -10,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "finecap/capture.h"
 #include "finecap/evaluation.h"
 #include "finecap/flow_evaluation.h"
 #include "finecap/heldout_score.h"
+#include "finecap/io/capture.h"
 #include "finecap/optical_flow.h"
 #include "finecap/refine.h"
 #include "finecap/run_folder.h"

@@ -23,8 +23,8 @@
 
 #include <Eigen/Core>
 
-#include "finecap/frame_range.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/frame_range.h"
+#include "finecap/io/mesh_io.h"
 
 namespace finecap {
 

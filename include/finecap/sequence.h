@@ -16,12 +16,12 @@
 
 #include <Eigen/Core>
 
-#include "finecap/capture.h"
-#include "finecap/frame_range.h"
 #include "finecap/frame_reader.h"
 #include "finecap/frame_stats.h"
 #include "finecap/heldout_score.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/capture.h"
+#include "finecap/io/frame_range.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/problem_size.h"
 #include "finecap/refine.h"
 #include "finecap/run_folder.h"

@@ -7,7 +7,7 @@
 
 #include <string>
 
-#include "finecap/frame_range.h"
+#include "finecap/io/frame_range.h"
 
 namespace finecap {
 

@@ -9,7 +9,7 @@
 #include <iostream>
 #include <sstream>
 
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

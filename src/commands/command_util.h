@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "finecap/capture.h"
 #include "finecap/config.h"
 #include "finecap/heldout_score.h"
+#include "finecap/io/capture.h"
 #include "finecap/refine.h"
 #include "finecap/run_folder.h"
 #include "finecap/scene_scale.h"

@@ -6,8 +6,8 @@
 
 #include "commands/command_util.h"
 #include "finecap/commands.h"
-#include "finecap/export.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/export.h"
+#include "finecap/io/mesh_io.h"
 
 namespace finecap {
 

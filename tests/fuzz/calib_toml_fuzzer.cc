@@ -3,7 +3,7 @@
 // accepted a rig it cannot write).
 #include <cstdio>
 
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,6 +1,6 @@
 // cameras.yaml: ReadCamerasYaml on arbitrary bytes; a rig that reads must survive a round trip
 // through WriteCamerasYaml unchanged.
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

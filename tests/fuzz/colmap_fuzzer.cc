@@ -1,7 +1,7 @@
 // A COLMAP text model: the input is cameras.txt, then a line "%%", then images.txt.
 #include <filesystem>
 
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

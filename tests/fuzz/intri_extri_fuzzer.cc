@@ -1,6 +1,6 @@
 // The OpenCV FileStorage pair intri.yml / extri.yml: the input is intri.yml, then a line "%%",
 // then extri.yml.
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,5 +1,5 @@
 // A .obj mesh: ReadMesh on arbitrary bytes; a mesh that reads is valid (Mesh::Validate).
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

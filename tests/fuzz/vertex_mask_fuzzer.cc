@@ -1,6 +1,6 @@
 // A vertex mask file (mask.txt, gt/textureless.txt) of a 1000-vertex mesh; what reads must be
 // sorted, unique and in range.
-#include "finecap/vertex_mask.h"
+#include "finecap/io/vertex_mask.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,5 +1,5 @@
 // Finding a capture's camera rig among the supported formats.
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 
 #include <algorithm>
 #include <cctype>

@@ -4,10 +4,10 @@
 #include <cmath>
 #include <iostream>
 
-#include "camera_io_util.h"
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "finecap/util/error.h"
-#include "toml_subset.h"
+#include "io/camera_io_util.h"
+#include "io/toml_subset.h"
 #include "util/io_util.h"
 
 namespace finecap {

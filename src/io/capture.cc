@@ -1,4 +1,4 @@
-#include "finecap/capture.h"
+#include "finecap/io/capture.h"
 
 #include <algorithm>
 #include <cctype>
@@ -7,10 +7,10 @@
 #include <map>
 #include <sstream>
 
-#include "finecap/camera_io.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/camera_io.h"
+#include "finecap/io/mesh_io.h"
+#include "finecap/io/vertex_mask.h"
 #include "finecap/util/error.h"
-#include "finecap/vertex_mask.h"
 #include "util/io_util.h"
 
 namespace finecap {

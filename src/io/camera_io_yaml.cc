@@ -4,10 +4,10 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "camera_io_util.h"
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
+#include "io/camera_io_util.h"
 #include "util/io_util.h"
 
 namespace finecap {

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "finecap/geometry/mesh.h"
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 
 namespace finecap {
 namespace internal {

@@ -1,4 +1,4 @@
-#include "finecap/frame_range.h"
+#include "finecap/io/frame_range.h"
 
 #include <algorithm>
 #include <cctype>

@@ -1,4 +1,4 @@
-#include "toml_subset.h"
+#include "io/toml_subset.h"
 
 #include <algorithm>
 #include <cerrno>

@@ -1,11 +1,11 @@
-#include "finecap/export.h"
+#include "finecap/io/export.h"
 
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 #include "util/io_util.h"

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "finecap/util/error.h"
-#include "mesh_io_internal.h"
+#include "io/mesh_io_internal.h"
 #include "util/io_util.h"
 
 namespace finecap {

@@ -1,4 +1,4 @@
-#include "finecap/mesh_io.h"
+#include "finecap/io/mesh_io.h"
 
 #include <algorithm>
 #include <cctype>
@@ -10,7 +10,7 @@
 
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
-#include "mesh_io_internal.h"
+#include "io/mesh_io_internal.h"
 #include "util/io_util.h"
 
 namespace finecap {

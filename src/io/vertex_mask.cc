@@ -1,4 +1,4 @@
-#include "finecap/vertex_mask.h"
+#include "finecap/io/vertex_mask.h"
 
 #include <algorithm>
 #include <sstream>

@@ -1,4 +1,4 @@
-#include "camera_io_util.h"
+#include "io/camera_io_util.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>
 
-#include "finecap/camera_io.h"
+#include "finecap/io/camera_io.h"
 #include "finecap/util/error.h"
 #include "util/io_util.h"
 

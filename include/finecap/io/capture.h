@@ -25,9 +25,9 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/frame_source.h"
 #include "finecap/geometry/camera.h"
 #include "finecap/geometry/mesh.h"
+#include "finecap/io/frame_source.h"
 
 namespace finecap {
 
