@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "finecap/geometry/color.h"
-#include "finecap/image_gaussians.h"
+#include "finecap/model/image_gaussians.h"
 
 namespace finecap {
 namespace {

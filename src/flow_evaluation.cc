@@ -5,8 +5,8 @@
 #include <limits>
 
 #include "finecap/geometry/render.h"
+#include "finecap/model/visibility.h"
 #include "finecap/util/error.h"
-#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {

@@ -8,7 +8,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "finecap/util/error.h"
-#include "option_checks.h"
+#include "util/option_checks.h"
 
 namespace finecap {
 

@@ -7,14 +7,14 @@
 // Each Check() names the C++ field it refuses; its ranges are the config schema's
 // (config_options_test walks the schema and holds them to it).
 #include "finecap/energy_options.h"
-#include "finecap/gaussian_overlap.h"
 #include "finecap/heldout_score.h"
+#include "finecap/model/gaussian_overlap.h"
 #include "finecap/optical_flow.h"
 #include "finecap/refine.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
 #include "finecap/util/error.h"
-#include "option_checks.h"
+#include "util/option_checks.h"
 
 namespace finecap {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "finecap/surface_projection.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 
 #include "finecap/frame_energy.h"
-#include "finecap/gaussian_pairs.h"
+#include "finecap/model/gaussian_pairs.h"
 
 namespace finecap {
 namespace {

@@ -1,6 +1,6 @@
 #include "finecap/regularizer.h"
 
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
 
 namespace finecap {
 

@@ -2,51 +2,12 @@
 
 #include <cmath>
 
-#include "finecap/surface_projection.h"
+#include "model/image_color.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
-namespace {
 
-// Keeps the weighted mean defined where no image Gaussian is in reach (it then tends to the
-// `fallback` colour). Overlaps are of the order of sigma^2 ~ 1-100.
-constexpr double kEmptyWeight = 1e-9;
-
-// The overlap-weighted mean of image Gaussians' colours, and its k-derivative.
-class ColorAccumulator {
- public:
-  explicit ColorAccumulator(const Eigen::Vector3d& fallback) : weighted_(kEmptyWeight * fallback) {}
-
-  void Add(OverlapForm form, const ProjectedGaussian& projected, const ImageGaussian& g,
-           bool with_derivative) {
-    double doverlap = 0.0;
-    const double overlap = GaussianOverlap(form, projected, Eigen::Vector2d(g.x, g.y), g.sigma,
-                                           with_derivative ? &doverlap : nullptr);
-    const Eigen::Vector3d color = g.Color().cast<double>();
-    weight_ += overlap;
-    weighted_ += overlap * color;
-    dweight_ += doverlap;
-    dweighted_ += doverlap * color;
-  }
-  Eigen::Vector3d Mean() const { return weighted_ / weight_; }
-  Eigen::Vector3d MeanDerivative() const { return (dweighted_ - Mean() * dweight_) / weight_; }
-
- private:
-  double weight_ = kEmptyWeight;
-  double dweight_ = 0.0;
-  Eigen::Vector3d weighted_;
-  Eigen::Vector3d dweighted_ = Eigen::Vector3d::Zero();
-};
-
-}  // namespace
-
-Eigen::Vector3d ImageColorAround(const ImageGaussians& image, const ProjectedGaussian& projected,
-                                 OverlapForm form, double reach_sigmas) {
-  std::vector<int> ids;
-  image.FindReaching(projected.mean, projected.sigma, reach_sigmas, &ids);
-  ColorAccumulator accumulator(Eigen::Vector3d::Zero());
-  for (int i : ids) accumulator.Add(form, projected, image[i], false);
-  return accumulator.Mean();
-}
+using internal::ColorAccumulator;
 
 SurfaceColorSimilarity::SurfaceColorSimilarity(const SurfaceGaussians& surface,
                                                const std::vector<EnergyView>& views,

@@ -7,7 +7,7 @@
 #include "finecap/geometry/mesh_smoothing.h"
 #include "finecap/synth.h"
 #include "finecap/util/error.h"
-#include "option_checks.h"
+#include "util/option_checks.h"
 
 namespace finecap {
 namespace {

@@ -7,7 +7,7 @@
 #include "finecap/frame_energy.h"
 #include "finecap/paper_similarity.h"
 #include "finecap/surface_color_similarity.h"
-#include "finecap/surface_projection.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
 namespace {

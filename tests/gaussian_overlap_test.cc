@@ -1,11 +1,11 @@
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
 
 #include <random>
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include "finecap/surface_projection.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
 namespace {

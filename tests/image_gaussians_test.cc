@@ -1,4 +1,4 @@
-#include "finecap/image_gaussians.h"
+#include "finecap/model/image_gaussians.h"
 
 #include <algorithm>
 #include <cmath>

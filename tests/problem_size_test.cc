@@ -6,8 +6,8 @@
 
 #include "energy_fixture.h"
 #include "finecap/frame_energy.h"
-#include "finecap/gaussian_pairs.h"
 #include "finecap/io/capture.h"
+#include "finecap/model/gaussian_pairs.h"
 #include "finecap/scene_scale.h"
 #include "finecap/synth.h"
 #include "test_util.h"

@@ -1,4 +1,4 @@
-#include "finecap/surface_gaussians.h"
+#include "finecap/model/surface_gaussians.h"
 
 #include <filesystem>
 #include <fstream>
@@ -6,8 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
+#include "finecap/model/visibility.h"
 #include "finecap/util/error.h"
-#include "finecap/visibility.h"
 
 namespace finecap {
 namespace {

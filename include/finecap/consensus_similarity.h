@@ -43,9 +43,9 @@
 #include <vector>
 
 #include "finecap/energy_options.h"
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
+#include "finecap/model/surface_gaussians.h"
 #include "finecap/similarity.h"
-#include "finecap/surface_gaussians.h"
 
 namespace finecap {
 

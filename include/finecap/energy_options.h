@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
 #include "finecap/util/enum_names.h"
 
 namespace finecap {

@@ -12,11 +12,11 @@
 #include <Eigen/Core>
 
 #include "finecap/energy_options.h"
-#include "finecap/gaussian_pairs.h"
 #include "finecap/geometry/neighbourhood.h"
+#include "finecap/model/gaussian_pairs.h"
+#include "finecap/model/surface_gaussians.h"
 #include "finecap/regularizer.h"
 #include "finecap/similarity.h"
-#include "finecap/surface_gaussians.h"
 
 namespace finecap {
 

@@ -15,9 +15,9 @@
 #include <Eigen/Core>
 
 #include "finecap/energy_options.h"
+#include "finecap/model/surface_gaussians.h"
 #include "finecap/regularizer.h"
 #include "finecap/similarity.h"
-#include "finecap/surface_gaussians.h"
 
 namespace finecap {
 

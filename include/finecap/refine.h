@@ -21,12 +21,12 @@
 #include "finecap/geometry/mesh.h"
 #include "finecap/geometry/neighbourhood.h"
 #include "finecap/geometry/subdivision.h"
-#include "finecap/image_gaussians.h"
+#include "finecap/model/image_gaussians.h"
+#include "finecap/model/surface_gaussians.h"
+#include "finecap/model/visibility.h"
 #include "finecap/solver.h"
-#include "finecap/surface_gaussians.h"
 #include "finecap/sweep.h"
 #include "finecap/util/enum_names.h"
-#include "finecap/visibility.h"
 
 namespace finecap {
 

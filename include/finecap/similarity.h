@@ -12,9 +12,9 @@
 
 #include <Eigen/Core>
 
-#include "finecap/gaussian_pairs.h"
 #include "finecap/geometry/camera.h"
-#include "finecap/image_gaussians.h"
+#include "finecap/model/gaussian_pairs.h"
+#include "finecap/model/image_gaussians.h"
 
 namespace finecap {
 

@@ -24,16 +24,11 @@
 
 #include <vector>
 
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
+#include "finecap/model/surface_gaussians.h"
 #include "finecap/similarity.h"
-#include "finecap/surface_gaussians.h"
 
 namespace finecap {
-
-// p_sc for one projected surface Gaussian: the overlap-weighted mean colour of the image
-// Gaussians within `reach_sigmas` combined standard deviations (zero when there is none).
-Eigen::Vector3d ImageColorAround(const ImageGaussians& image, const ProjectedGaussian& projected,
-                                 OverlapForm form, double reach_sigmas);
 
 // p_sc at displacement k of the surface Gaussian in row `row` of `view`'s pair list, over the
 // pairs of that row, and, when `derivative` is not null, dp_sc/dk. Where no image Gaussian is in

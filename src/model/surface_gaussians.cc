@@ -1,15 +1,15 @@
-#include "finecap/surface_gaussians.h"
+#include "finecap/model/surface_gaussians.h"
 
 #include <cmath>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
-#include "finecap/surface_color_similarity.h"
-#include "finecap/surface_projection.h"
+#include "finecap/model/visibility.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
-#include "finecap/visibility.h"
+#include "model/image_color.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
 namespace {

@@ -1,4 +1,4 @@
-#include "finecap/gaussian_overlap.h"
+#include "finecap/model/gaussian_overlap.h"
 
 namespace finecap {
 

@@ -5,8 +5,8 @@
 
 #include <Eigen/Core>
 
-#include "finecap/gaussian_overlap.h"
 #include "finecap/geometry/camera.h"
+#include "finecap/model/gaussian_overlap.h"
 
 namespace finecap {
 

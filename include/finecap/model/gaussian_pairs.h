@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "finecap/geometry/camera.h"
-#include "finecap/image_gaussians.h"
-#include "finecap/surface_gaussians.h"
+#include "finecap/model/image_gaussians.h"
+#include "finecap/model/surface_gaussians.h"
 
 namespace finecap {
 

@@ -10,10 +10,10 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/gaussian_overlap.h"
 #include "finecap/geometry/camera.h"
 #include "finecap/geometry/color.h"
-#include "finecap/image_gaussians.h"
+#include "finecap/model/gaussian_overlap.h"
+#include "finecap/model/image_gaussians.h"
 #include "finecap/util/enum_names.h"
 
 namespace finecap {

@@ -1,4 +1,4 @@
-#include "finecap/image_gaussians.h"
+#include "finecap/model/image_gaussians.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <exception>
 
 #include "finecap/util/error.h"
-#include "option_checks.h"
+#include "util/option_checks.h"
 
 namespace finecap {
 namespace {

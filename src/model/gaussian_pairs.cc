@@ -1,10 +1,10 @@
-#include "finecap/gaussian_pairs.h"
+#include "finecap/model/gaussian_pairs.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "finecap/gaussian_overlap.h"
-#include "finecap/surface_projection.h"
+#include "finecap/model/gaussian_overlap.h"
+#include "model/surface_projection.h"
 
 namespace finecap {
 namespace {

@@ -1,9 +1,9 @@
-#include "finecap/visibility.h"
+#include "finecap/model/visibility.h"
 
 #include <cmath>
 
 #include "finecap/util/error.h"
-#include "option_checks.h"
+#include "util/option_checks.h"
 
 namespace finecap {
 
