@@ -1,12 +1,12 @@
-// The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h)
-// and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
+// The Check() of the options structs of refinement (refine.h, solver.h, sweep.h) and of the
+// held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
 // of the optical flow's (optical_flow.h), which the config's eval section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
 //
 // Each Check() names the C++ field it refuses; its ranges are the config schema's
 // (config_options_test walks the schema and holds them to it).
-#include "finecap/energy_options.h"
+#include "finecap/energy/energy_options.h"
 #include "finecap/heldout_score.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/optical_flow.h"
@@ -20,20 +20,6 @@ namespace finecap {
 
 using internal::RequireFieldRange;
 using internal::RequireKnownChoice;
-
-const std::vector<EnumName<SimilarityType>>& EnumNames(SimilarityType) {
-  static const std::vector<EnumName<SimilarityType>> names = {
-      {SimilarityType::kPaper, "paper"},
-      {SimilarityType::kSurfaceColor, "surface_color"},
-      {SimilarityType::kConsensus, "consensus"}};
-  return names;
-}
-
-const std::vector<EnumName<RegUnit>>& EnumNames(RegUnit) {
-  static const std::vector<EnumName<RegUnit>> names = {{RegUnit::kMillimetres, "mm"},
-                                                       {RegUnit::kMetres, "m"}};
-  return names;
-}
 
 const std::vector<EnumName<SolverType>>& EnumNames(SolverType) {
   static const std::vector<EnumName<SolverType>> names = {
@@ -88,30 +74,6 @@ void RefineOptions::Check() const {
   solver.Check();
   sweep.Check();
   coarse_to_fine.Check();
-}
-
-void EnergyOptions::Check() const {
-  RequireKnownChoice(similarity, "EnergyOptions::similarity");
-  consensus.Check();
-  RequireKnownChoice(overlap, "EnergyOptions::overlap");
-  RequireFieldRange(color_cutoff, 1e-6, 10.0, "EnergyOptions::color_cutoff");
-  RequireFieldRange(reach_sigmas, 0.5, 10.0, "EnergyOptions::reach_sigmas");
-  RequireFieldRange(k_max, 1e-5, 1.0, "EnergyOptions::k_max");
-  RequireFieldRange(w_reg, 0.0, 1e12, "EnergyOptions::w_reg");
-  RequireFieldRange(w_prior, 0.0, 1e12, "EnergyOptions::w_prior");
-  RequireFieldRange(confidence_prior, 0.0, 1e6, "EnergyOptions::confidence_prior");
-  RequireFieldRange(confidence_threshold, 1e-9, 1e3, "EnergyOptions::confidence_threshold");
-  RequireFieldRange(confidence_opening, 0, 20, "EnergyOptions::confidence_opening");
-  RequireFieldRange(reg_rings, 1, 10, "EnergyOptions::reg_rings");
-  RequireKnownChoice(reg_unit, "EnergyOptions::reg_unit");
-}
-
-void ConsensusOptions::Check() const {
-  RequireFieldRange(contrast_floor, 1e-6, 1.0, "ConsensusOptions::contrast_floor");
-  RequireFieldRange(min_cameras, 2, 64, "ConsensusOptions::min_cameras");
-  RequireFieldRange(passes, 1, 10, "ConsensusOptions::passes");
-  RequireFieldRange(patch_rings, 1, 4, "ConsensusOptions::patch_rings");
-  RequireFieldRange(robust_fraction, 0.0, 100.0, "ConsensusOptions::robust_fraction");
 }
 
 void SolverOptions::Check() const {

@@ -1,10 +1,10 @@
 #include "finecap/problem_size.h"
 
-#include "finecap/consensus_similarity.h"
+#include "energy/consensus_similarity.h"
 
 #include <algorithm>
 
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/model/gaussian_pairs.h"
 
 namespace finecap {

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <functional>
 
-#include "finecap/consensus_similarity.h"
-#include "finecap/frame_energy.h"
+#include "energy/consensus_similarity.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/render.h"
 #include "finecap/util/error.h"
 

@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/mesh.h"
 
 namespace finecap {

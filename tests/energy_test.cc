@@ -2,11 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include "energy/consensus_similarity.h"
+#include "energy/paper_similarity.h"
+#include "energy/surface_color_similarity.h"
 #include "energy_fixture.h"
-#include "finecap/consensus_similarity.h"
-#include "finecap/frame_energy.h"
-#include "finecap/paper_similarity.h"
-#include "finecap/surface_color_similarity.h"
+#include "finecap/energy/frame_energy.h"
 #include "model/surface_projection.h"
 
 namespace finecap {

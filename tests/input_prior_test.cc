@@ -1,4 +1,4 @@
-#include "finecap/input_prior.h"
+#include "energy/input_prior.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/io/capture.h"
 #include "finecap/model/gaussian_pairs.h"
 #include "finecap/scene_scale.h"

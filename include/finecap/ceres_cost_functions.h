@@ -11,7 +11,7 @@
 #include <ceres/evaluation_callback.h>
 #include <Eigen/Core>
 
-#include "finecap/similarity.h"
+#include "finecap/energy/similarity.h"
 
 namespace finecap {
 

@@ -15,8 +15,8 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
-#include "finecap/energy_options.h"
-#include "finecap/frame_energy.h"
+#include "finecap/energy/energy_options.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/camera.h"
 #include "finecap/geometry/mesh.h"
 #include "finecap/geometry/neighbourhood.h"

@@ -18,7 +18,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 #include "finecap/util/enum_names.h"
 
 namespace finecap {

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 
 namespace finecap {
 

@@ -24,9 +24,9 @@
 
 #include <vector>
 
+#include "finecap/energy/similarity.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/model/surface_gaussians.h"
-#include "finecap/similarity.h"
 
 namespace finecap {
 

@@ -1,4 +1,4 @@
-#include "finecap/surface_color_similarity.h"
+#include "energy/surface_color_similarity.h"
 
 #include <cmath>
 

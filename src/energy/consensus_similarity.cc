@@ -1,9 +1,9 @@
-#include "finecap/consensus_similarity.h"
+#include "energy/consensus_similarity.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "finecap/surface_color_similarity.h"
+#include "energy/surface_color_similarity.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

@@ -1,9 +1,9 @@
-#include "finecap/frame_energy.h"
+#include "finecap/energy/frame_energy.h"
 
-#include "finecap/consensus_similarity.h"
-#include "finecap/input_prior.h"
-#include "finecap/paper_similarity.h"
-#include "finecap/surface_color_similarity.h"
+#include "energy/consensus_similarity.h"
+#include "energy/input_prior.h"
+#include "energy/paper_similarity.h"
+#include "energy/surface_color_similarity.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

@@ -1,4 +1,4 @@
-#include "finecap/paper_similarity.h"
+#include "energy/paper_similarity.h"
 
 #include <cmath>
 

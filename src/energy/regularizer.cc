@@ -1,4 +1,4 @@
-#include "finecap/regularizer.h"
+#include "finecap/energy/regularizer.h"
 
 #include "finecap/model/gaussian_overlap.h"
 

@@ -11,12 +11,12 @@
 
 #include <Eigen/Core>
 
-#include "finecap/energy_options.h"
+#include "finecap/energy/energy_options.h"
+#include "finecap/energy/regularizer.h"
+#include "finecap/energy/similarity.h"
 #include "finecap/geometry/neighbourhood.h"
 #include "finecap/model/gaussian_pairs.h"
 #include "finecap/model/surface_gaussians.h"
-#include "finecap/regularizer.h"
-#include "finecap/similarity.h"
 
 namespace finecap {
 

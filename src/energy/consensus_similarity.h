@@ -42,10 +42,10 @@
 
 #include <vector>
 
-#include "finecap/energy_options.h"
+#include "finecap/energy/energy_options.h"
+#include "finecap/energy/similarity.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/model/surface_gaussians.h"
-#include "finecap/similarity.h"
 
 namespace finecap {
 
