@@ -1,5 +1,5 @@
-// The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h)
-// and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
+// The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h,
+// the colour options of sequence.h) and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
 // of the optical flow's (optical_flow.h), which the config's eval section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
@@ -11,6 +11,7 @@
 #include "finecap/heldout_score.h"
 #include "finecap/optical_flow.h"
 #include "finecap/refine.h"
+#include "finecap/sequence.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
 #include "finecap/util/error.h"
@@ -76,6 +77,18 @@ const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSourc
       {ReferenceColorSource::kPixels, "pixels"},
       {ReferenceColorSource::kImageModel, "image_model"}};
   return names;
+}
+
+const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface) {
+  static const std::vector<EnumName<ReferenceSurface>> names = {
+      {ReferenceSurface::kCoarse, "coarse"}, {ReferenceSurface::kRefined, "refined"}};
+  return names;
+}
+
+void ReferenceColorOptions::Check() const {
+  internal::RequireKnownChoice(reference_surface, "ReferenceColorOptions::reference_surface");
+  internal::RequireFieldRange(follow_colors, 0.0, 1.0, "ReferenceColorOptions::follow_colors");
+  internal::RequireFieldRange(follow_anchor, 0.0, 1.0, "ReferenceColorOptions::follow_anchor");
 }
 
 void RefineOptions::Check() const {

@@ -72,21 +72,25 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
 
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
                                       const RefineOptions& options) {
+  return ComputeSurfaceColors(model.Subdivide(reference.coarse), reference, options);
+}
+
+ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
+                                     const RefineOptions& options) {
   options.Check();
-  const Mesh fine = model.Subdivide(reference.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible = ComputeFrameVisibility(fine, normals, reference.cameras, options.visibility);
+  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility);
   if (options.reference_colors == ReferenceColorSource::kImageModel) {
     std::vector<std::string> names;
-    for (const Camera& camera : reference.cameras) names.push_back(camera.name);
+    for (const Camera& camera : frame.cameras) names.push_back(camera.name);
     const std::vector<ImageGaussians> images =
-        BuildFrameImageGaussians(reference.images, {}, options.image, names);
-    return ComputeModelReferenceColors(fine.vertices, normals, reference.cameras, images, visible,
+        BuildFrameImageGaussians(frame.images, {}, options.image, names);
+    return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
                                        options.sigma_hat, options.energy.overlap,
                                        options.energy.reach_sigmas);
   }
-  return ComputeReferenceColors(fine.vertices, normals, reference.cameras, reference.images,
-                                visible, options.image.color_space, options.sigma_hat);
+  return ComputeReferenceColors(fine.vertices, normals, frame.cameras, frame.images, visible,
+                                options.image.color_space, options.sigma_hat);
 }
 
 namespace {
