@@ -1,6 +1,7 @@
 // The Check() of the options structs of refinement (refine.h, energy_options.h, solver.h, sweep.h,
-// the colour options of sequence.h) and of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
-// of the optical flow's (optical_flow.h), which the config's eval section lists:
+// the colour options of sequence.h) and of the held-out score (heldout_score.h), and the names of
+// their choices (enum_names.h) and of the optical flow's (optical_flow.h), which the config's eval
+// section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
 //

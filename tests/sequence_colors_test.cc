@@ -4,6 +4,8 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -230,21 +232,14 @@ TEST(SequenceColorsTest, ConfigKeysAreCheckedAndFollowingRefusesShards) {
   EXPECT_EQ(config.colors.follow_anchor, 0.05);
   EXPECT_EQ(Config().colors.reference_surface, ReferenceSurface::kRefined);
   EXPECT_EQ(Config().colors.follow_colors, 0.0);
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"model.follow_colors", "1.5", "--set"}});
-      },
-      {"model.follow_colors", "1.5"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"model.follow_anchor", "-0.1", "--set"}});
-      },
-      {"model.follow_anchor"});
-  ExpectErrorMentions(
-      [] {
-        LoadConfig("", {{"model.reference_surface", "fine", "--set"}});
-      },
-      {"model.reference_surface", "fine"});
+  // Out of range or not a choice: one error naming the key and the value.
+  const std::vector<std::pair<std::string, std::string>> wrong = {
+      {"model.follow_colors", "1.5"},
+      {"model.follow_anchor", "-0.1"},
+      {"model.reference_surface", "fine"}};
+  for (const auto& [key, value] : wrong) {
+    ExpectErrorMentions([&] { LoadConfig("", {{key, value, "--set"}}); }, {key, value});
+  }
   ExpectErrorMentions(
       [] {
         LoadConfig("",
