@@ -148,22 +148,21 @@ void ConsensusSimilarity::BuildTables(double k_max) {
   node_step_ = 2.0 * k_max / (num_nodes_ - 1);
   node_k0_ = -k_max;
   table_.resize(views_.size());
-  table_derivative_.resize(views_.size());
   for (size_t c = 0; c < views_.size(); ++c) {
     const EnergyView& view = views_[c];
     const int num_rows = static_cast<int>(view.pairs.surface_ids.size());
     table_[c].resize(long(num_rows) * num_nodes_);
-    table_derivative_[c].resize(long(num_rows) * num_nodes_);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int row = 0; row < num_rows; ++row) {
       const int j = view.pairs.surface_ids[row];
       for (int g = 0; g < num_nodes_; ++g) {
         const long entry = long(row) * num_nodes_ + g;
         Eigen::Vector3d derivative;
-        table_[c][entry] = ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_, form_,
-                                             surface_.colors[j].cast<double>(), &derivative)
-                               .cast<float>();
-        table_derivative_[c][entry] = derivative.cast<float>();
+        table_[c][entry].color =
+            ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_, form_,
+                              surface_.colors[j].cast<double>(), &derivative)
+                .cast<float>();
+        table_[c][entry].slope = (node_step_ * derivative).cast<float>();
       }
     }
   }
@@ -191,11 +190,11 @@ Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
   const double x = std::clamp((k - node_k0_) / node_step_, 0.0, num_nodes_ - 1.0);
   const int g = std::min(static_cast<int>(x), num_nodes_ - 2);
   const double t = x - g, t2 = t * t, t3 = t2 * t;
-  const long entry = long(row) * num_nodes_ + g;
-  const Eigen::Vector3d p0 = table_[c][entry].cast<double>();
-  const Eigen::Vector3d p1 = table_[c][entry + 1].cast<double>();
-  const Eigen::Vector3d m0 = node_step_ * table_derivative_[c][entry].cast<double>();
-  const Eigen::Vector3d m1 = node_step_ * table_derivative_[c][entry + 1].cast<double>();
+  const TableNode* node = &table_[c][long(row) * num_nodes_ + g];
+  const Eigen::Vector3d p0 = node[0].color.cast<double>();
+  const Eigen::Vector3d p1 = node[1].color.cast<double>();
+  const Eigen::Vector3d m0 = node[0].slope.cast<double>();
+  const Eigen::Vector3d m1 = node[1].slope.cast<double>();
   if (derivative != nullptr) {
     const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
     derivative->setZero();

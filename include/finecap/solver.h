@@ -48,8 +48,11 @@ struct SolverOptions {
 
   // Ceres only: trust-region strategy.
   TrustRegionType trust_region = TrustRegionType::kLevenbergMarquardt;
-  // Ceres only: the linear solver; kCgnr is the iterative option.
-  LinearSolverType linear_solver = LinearSolverType::kSparseNormalCholesky;
+  // Ceres only: the linear solver. Conjugate gradients by default: the normal equations are
+  // diagonal but for the regulariser, so a few products solve them to the accuracy the step
+  // needs, at a fifth of the time of SuiteSparse's factorisation on synth_skirt and to the same
+  // error on every capture measured (README, "Where a frame's time goes").
+  LinearSolverType linear_solver = LinearSolverType::kCgnr;
 
   // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
   // are scaled from it). Default 0.5 mm; a refinement makes it follow from the scene unless set
