@@ -192,6 +192,24 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
   }
 }
 
+// A similarity that says it is a least-squares term is one: its E is minus half the sum of
+// squares of its residuals, which lets the solvers take E from the least-squares cost.
+TEST_P(CeresCostTest, LeastSquaresTermsAgreeWithTheirResiduals) {
+  const auto [similarity, overlap] = GetParam();
+  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options(similarity, overlap));
+  Eigen::VectorXd k(energy.num_parameters());
+  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  SimilarityTerm& term = energy.similarity();
+  EXPECT_EQ(term.IsLeastSquares(), similarity != "paper");
+  if (!term.IsLeastSquares()) return;
+  double e = 0.0, cost = 0.0;
+  EvaluateEnergyAndCost(&energy, k, &e, &cost);
+  EXPECT_NEAR(e, energy.Evaluate(k, nullptr), 1e-12 * (1.0 + std::abs(e)));
+  EXPECT_NEAR(cost, -e, 1e-12 * (1.0 + std::abs(e)));
+}
+
 // A term of one block with fixed residuals and Jacobian, for the reduction of a block of several
 // parameters (QR), which no similarity of the product needs today.
 class FixedBlockTerm : public SimilarityTerm {

@@ -64,6 +64,7 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+  bool IsLeastSquares() const override { return true; }
 
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
   // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.

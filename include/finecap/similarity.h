@@ -46,6 +46,10 @@ class SimilarityTerm {
   // residuals[r] for r < num_residuals; when `jacobian` is not null, jacobian[r * P + p] =
   // d residual r / d k of parameters[p], P = parameters.size().
   virtual void BlockResiduals(int block, double* residuals, double* jacobian) const = 0;
+
+  // True when Evaluate(k) is exactly minus half the sum of squares of the residuals at k: then
+  // the least-squares cost gives the similarity too, and a solver need not evaluate both.
+  virtual bool IsLeastSquares() const { return false; }
 };
 
 }  // namespace finecap

@@ -96,6 +96,11 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
 // 1/2 sum of squared residuals of the least-squares form at k (similarity and regulariser).
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k);
 
+// The energy E and the least-squares cost at k, with one evaluation of the similarity when it
+// is a least-squares term (E = -cost), two otherwise.
+void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double* energy_value,
+                           double* cost);
+
 }  // namespace finecap
 
 #endif  // FINECAP_SOLVER_H_

@@ -109,6 +109,10 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   ceres::Solve(ceres_options, &problem, &ceres_summary);
   VLOG(1) << ceres_summary.FullReport();
 
+  if (ceres_summary.IsSolutionUsable()) {  // Else Ceres' costs are not those of its start and end.
+    summary->ls_cost_start = ceres_summary.initial_cost;
+    summary->ls_cost_end = ceres_summary.final_cost;
+  }
   summary->iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
   summary->evaluations = ceres_summary.num_residual_evaluations;
   summary->termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
