@@ -169,11 +169,16 @@ void ConsensusSimilarity::BuildTables(double k_max) {
 }
 
 void ConsensusSimilarity::PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                                      std::vector<Eigen::Vector3d>* derivatives) const {
+                                      std::vector<Eigen::Vector3d>* derivatives,
+                                      const RowColors* row_colors) const {
   const int c = cameras_[a];
   const std::vector<int>& rows = rows_[a];
   const int n = static_cast<int>(rows.size());
   colors->resize(n);
+  if (row_colors != nullptr) {
+    for (int m = 0; m < n; ++m) (*colors)[m] = (*row_colors)[c][rows[m]];
+    return;
+  }
   if (derivatives != nullptr) derivatives->resize(n);
   const EnergyView& view = views_[c];
   const double centre_shape = shape_[view.pairs.surface_ids[rows[0]]];
@@ -227,12 +232,13 @@ Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
   return (variance / (camera_begin_[b + 1] - camera_begin_[b])).cwiseSqrt();
 }
 
-void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
+void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian,
+                                  const RowColors* row_colors) const {
   const int num_cameras = camera_begin_[b + 1] - camera_begin_[b];
   std::vector<std::vector<Eigen::Vector3d>> z(num_cameras), dz(num_cameras);
   std::vector<Eigen::Vector3d> q, dq;
   for (int a = 0; a < num_cameras; ++a) {
-    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr);
+    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr, row_colors);
     Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor,
               !options_.gain_per_channel, &z[a], &dz[a]);
   }
@@ -294,6 +300,36 @@ void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_j
   for (int b = 0; b < num_blocks; ++b) {
     BlockAt(b, k[blocks_[b].parameters[0]], &residuals_[residual_begin_[b]],
             with_jacobians ? &jacobians_[residual_begin_[b]] : nullptr);
+  }
+}
+
+void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
+  const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
+  if (!uniform) {
+    SimilarityTerm::BlockCosts(k, costs);
+    return;
+  }
+  RowColors row_colors(views_.size());
+  for (size_t c = 0; c < views_.size(); ++c) {
+    const int num_rows = static_cast<int>(views_[c].pairs.surface_ids.size());
+    row_colors[c].resize(num_rows);
+#pragma omp parallel for schedule(static)
+    for (int row = 0; row < num_rows; ++row)
+      row_colors[c][row] = Interpolate(c, row, k[0], nullptr);
+  }
+  const int num_blocks = static_cast<int>(blocks_.size());
+  costs->resize(num_blocks);
+#pragma omp parallel
+  {
+    std::vector<double> residuals;
+#pragma omp for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      residuals.resize(blocks_[b].num_residuals);
+      BlockAt(b, k[0], residuals.data(), nullptr, &row_colors);
+      double cost = 0.0;
+      for (double r : residuals) cost += r * r;
+      (*costs)[b] = cost;
+    }
   }
 }
 

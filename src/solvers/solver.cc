@@ -9,21 +9,10 @@
 namespace finecap {
 
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
-  SimilarityTerm& similarity = energy->similarity();
-  similarity.PrepareResiduals(k, false);
-  const auto& blocks = similarity.residual_blocks();
-  const int num_blocks = static_cast<int>(blocks.size());
+  std::vector<double> block_costs;
+  energy->similarity().BlockCosts(k, &block_costs);
   double sum_of_squares = 0.0;
-#pragma omp parallel reduction(+ : sum_of_squares)
-  {
-    std::vector<double> residuals;
-#pragma omp for schedule(dynamic, 256)
-    for (int b = 0; b < num_blocks; ++b) {
-      residuals.resize(blocks[b].num_residuals);
-      similarity.BlockResiduals(b, residuals.data(), nullptr);
-      for (double r : residuals) sum_of_squares += r * r;
-    }
-  }
+  for (double cost : block_costs) sum_of_squares += cost;
   // The regulariser's residuals are 2 sqrt(w T) u (k_a - k_b): their half sum of squares is
   // w_reg * E_reg; the prior's, sqrt(p_s) k_s, give E_prior.
   const Eigen::VectorXd& prior = energy->prior_curvature();
