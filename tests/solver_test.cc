@@ -9,6 +9,7 @@
 
 #include "energy_fixture.h"
 #include "finecap/ceres_cost_functions.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
@@ -283,6 +284,20 @@ TEST_P(SolverTest, ImprovesTheEnergyWithinBounds) {
   EXPECT_LE(k.cwiseAbs().maxCoeff(), energy.options().k_max + 1e-12);
   EXPECT_GT(summary.iterations, 0);
   EXPECT_FALSE(summary.trace.empty());
+}
+
+// Ceres' dogleg takes exact Gauss-Newton steps: with conjugate gradients the options are refused
+// before any solve, instead of a solve that stops at once.
+TEST(SolverOptionsTest, DoglegNeedsAnExactLinearSolver) {
+  SolverOptions options;
+  options.trust_region = TrustRegionType::kDogleg;
+  options.linear_solver = LinearSolverType::kCgnr;
+  EXPECT_THROW(options.Check(), Error);
+  options.linear_solver = LinearSolverType::kSparseNormalCholesky;
+  EXPECT_NO_THROW(options.Check());
+  options.linear_solver = LinearSolverType::kCgnr;
+  options.type = SolverType::kGradientAscent;  // No trust region there: nothing to refuse.
+  EXPECT_NO_THROW(options.Check());
 }
 
 INSTANTIATE_TEST_SUITE_P(AllSolvers, SolverTest,
