@@ -135,6 +135,11 @@ void SolverOptions::Check() const {
   Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
   RequireKnownChoice(trust_region, "SolverOptions::trust_region");
   RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
+  // Ceres' dogleg needs the exact Gauss-Newton step, which conjugate gradients do not give.
+  Require(type != SolverType::kCeres || trust_region != TrustRegionType::kDogleg ||
+              linear_solver != LinearSolverType::kCgnr,
+          "SolverOptions::trust_region",
+          "dogleg needs an exact linear solver (sparse_normal_cholesky or dense_qr), not cgnr");
   RequireFieldRange(initial_step, 1e-9, 1.0, "SolverOptions::initial_step");
   RequireFieldRange(step_growth, 1.0, 10.0, "SolverOptions::step_growth");
   RequireFieldRange(step_shrink, 1e-3, 0.999, "SolverOptions::step_shrink");

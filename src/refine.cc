@@ -166,8 +166,9 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
   }
   if (options.energy.consensus.passes > 1) {
-    summary.energy_start = energy->Evaluate(start, nullptr);
-    summary.ls_cost_start = LeastSquaresCost(energy, start);
+    // Both ends by the same sum: the solver's own (Ceres') may differ from it in the last digit.
+    EvaluateEnergyAndCost(energy, start, &summary.energy_start, &summary.ls_cost_start);
+    EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
   }
   return summary;
 }
@@ -237,8 +238,9 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = SolveFrameEnergy(&energy, options, &k);
   if (coarse_k.size() > 0) {
-    result.summary.energy_start = energy.Evaluate(initial, nullptr);
-    result.summary.ls_cost_start = LeastSquaresCost(&energy, initial);
+    EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
+                          &result.summary.ls_cost_start);
+    EvaluateEnergyAndCost(&energy, k, &result.summary.energy_end, &result.summary.ls_cost_end);
     result.summary.iterations += coarse.iterations;
     result.summary.evaluations += coarse.evaluations;
     result.summary.seconds += coarse.seconds;
