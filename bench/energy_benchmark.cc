@@ -19,6 +19,7 @@
 #include "finecap/frame_reader.h"
 #include "finecap/io/capture.h"
 #include "finecap/refine.h"
+#include "finecap/sweep.h"
 
 namespace finecap {
 namespace {
@@ -73,6 +74,10 @@ void BM_EnergyAndGradient(benchmark::State& state, const std::string& similarity
   state.counters["surface_gaussians"] = frame.energy->num_parameters();
   state.counters["pairs"] = static_cast<double>(frame.energy->num_pairs());
 }
+BENCHMARK_CAPTURE(BM_EnergyAndGradient, consensus, std::string("consensus"))
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_EnergyAndGradient, surface_color, std::string("surface_color"))
     ->Arg(1)
     ->Arg(0)
@@ -81,6 +86,18 @@ BENCHMARK_CAPTURE(BM_EnergyAndGradient, paper, std::string("paper"))
     ->Arg(1)
     ->Arg(0)
     ->Unit(benchmark::kMillisecond);
+
+// The plane-sweep start of a prepared frame (the default similarity): the data cost of every
+// surface Gaussian at each of refine.sweep.samples displacements, smoothed over its neighbours.
+void BM_SweepInitialization(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const RefineOptions options;
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(SweepInitialization(frame.energy.get(), options.sweep).data());
+  }
+}
+BENCHMARK(BM_SweepInitialization)->Unit(benchmark::kMillisecond);
 
 void BM_PrepareFrame(benchmark::State& state) {
   const SkirtFrame& skirt = Skirt();

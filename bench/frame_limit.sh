@@ -32,9 +32,9 @@ median_of() {
 
 # Medians of 5 repetitions, milliseconds.
 bench=$(build/energy_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
-  --benchmark_filter='BM_EnergyAndGradient/surface_color/0|BM_ReadFrame|BM_PrepareFrame' 2>/dev/null)
+  --benchmark_filter='BM_EnergyAndGradient/consensus/0|BM_ReadFrame|BM_PrepareFrame' 2>/dev/null)
 ms_of() { echo "$bench" | awk -v n="$1" '$1 ~ n && $1 ~ /_median$/ { print $2; exit }'; }
-evaluation_ms=$(ms_of 'BM_EnergyAndGradient/surface_color/0')
+evaluation_ms=$(ms_of 'BM_EnergyAndGradient/consensus/0')
 read_ms=$(ms_of 'BM_ReadFrame')
 prepare_ms=$(ms_of 'BM_PrepareFrame')
 

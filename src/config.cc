@@ -133,6 +133,19 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                  "Frame (index in the sorted frame list) whose images colour the surface "
                  "Gaussians; the paper: the first.",
                  0);
+  schema->AddEnum("model.reference_surface", &config->colors.reference_surface,
+                  "Where the reference frame colours the surface Gaussians (surface_color, "
+                  "paper): coarse (its input surface, the paper) or refined (that frame refined "
+                  "first with the default consensus similarity). No effect under consensus.");
+  schema->AddDouble("model.follow_colors", &config->colors.follow_colors,
+                    "Rate at which the colours follow the sequence, blended in from each refined "
+                    "frame not flagged worse; 0 = fixed at the reference frame (the paper). "
+                    "Sequential: not with runtime.shard. No effect under consensus.",
+                    0.0, 1.0);
+  schema->AddDouble("model.follow_anchor", &config->colors.follow_anchor,
+                    "Pull of the followed colours back towards the reference colours after each "
+                    "frame (against drift).",
+                    0.0, 1.0);
   schema->AddInt("model.subdivision_levels", &refine.subdivision_levels,
                  "Loop subdivision levels applied to the coarse mesh before refinement.", 0, 4);
   schema->AddDoubleOrAuto(
@@ -295,6 +308,7 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
 const std::vector<std::pair<std::string, std::vector<std::string>>>& FieldSections() {
   static const std::vector<std::pair<std::string, std::vector<std::string>>> sections = {
       {"RefineOptions::", {"model.", "refine."}},
+      {"ReferenceColorOptions::", {"model."}},
       {"ImageGaussianOptions::", {"image_gaussians."}},
       {"VisibilityOptions::", {"visibility."}},
       {"EnergyOptions::", {"energy."}},
@@ -350,6 +364,10 @@ void CheckConfig(const Config& config, const std::string& source) {
 void Config::Check() const {
   frame_range();
   refine.Check();
+  colors.Check();
+  Require(!colors.following() || runtime.shard.count == 1, "model.follow_colors",
+          "follows the colours frame after frame, which runtime.shard " + runtime.shard.ToString() +
+              " splits between processes: run without shards, or set model.follow_colors: 0");
   validation.score.Check();
   synth.Check();
   compare.Check();

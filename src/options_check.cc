@@ -1,6 +1,7 @@
-// The Check() of the options structs of refinement (refine.h, solver.h, sweep.h) and of the
-// held-out score (heldout_score.h), and the names of their choices (enum_names.h) and
-// of the optical flow's (optical_flow.h), which the config's eval section lists:
+// The Check() of the options structs of refinement (refine.h, solver.h, sweep.h, the colour
+// options of sequence.h) and of the held-out score (heldout_score.h), and the names of their
+// choices (enum_names.h) and of the optical flow's (optical_flow.h), which the config's eval
+// section lists:
 // pure validation, kept apart from the stages' code so that reading a config links none of the
 // stages (the config fuzzer builds from the parser sources alone).
 //
@@ -11,6 +12,7 @@
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/optical_flow.h"
 #include "finecap/refine.h"
+#include "finecap/sequence.h"
 #include "finecap/solver.h"
 #include "finecap/sweep.h"
 #include "finecap/util/error.h"
@@ -64,6 +66,18 @@ const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSourc
   return names;
 }
 
+const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface) {
+  static const std::vector<EnumName<ReferenceSurface>> names = {
+      {ReferenceSurface::kCoarse, "coarse"}, {ReferenceSurface::kRefined, "refined"}};
+  return names;
+}
+
+void ReferenceColorOptions::Check() const {
+  internal::RequireKnownChoice(reference_surface, "ReferenceColorOptions::reference_surface");
+  internal::RequireFieldRange(follow_colors, 0.0, 1.0, "ReferenceColorOptions::follow_colors");
+  internal::RequireFieldRange(follow_anchor, 0.0, 1.0, "ReferenceColorOptions::follow_anchor");
+}
+
 void RefineOptions::Check() const {
   RequireFieldRange(subdivision_levels, 0, 4, "RefineOptions::subdivision_levels");
   RequireFieldRange(sigma_hat, 1e-5, 1.0, "RefineOptions::sigma_hat");
@@ -83,6 +97,11 @@ void SolverOptions::Check() const {
   Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
   RequireKnownChoice(trust_region, "SolverOptions::trust_region");
   RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
+  // Ceres' dogleg needs the exact Gauss-Newton step, which conjugate gradients do not give.
+  Require(type != SolverType::kCeres || trust_region != TrustRegionType::kDogleg ||
+              linear_solver != LinearSolverType::kCgnr,
+          "SolverOptions::trust_region",
+          "dogleg needs an exact linear solver (sparse_normal_cholesky or dense_qr), not cgnr");
   RequireFieldRange(initial_step, 1e-9, 1.0, "SolverOptions::initial_step");
   RequireFieldRange(step_growth, 1.0, 10.0, "SolverOptions::step_growth");
   RequireFieldRange(step_shrink, 1e-3, 0.999, "SolverOptions::step_shrink");

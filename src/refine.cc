@@ -72,21 +72,25 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
 
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
                                       const RefineOptions& options) {
+  return ComputeSurfaceColors(model.Subdivide(reference.coarse), reference, options);
+}
+
+ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
+                                     const RefineOptions& options) {
   options.Check();
-  const Mesh fine = model.Subdivide(reference.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible = ComputeFrameVisibility(fine, normals, reference.cameras, options.visibility);
+  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility);
   if (options.reference_colors == ReferenceColorSource::kImageModel) {
     std::vector<std::string> names;
-    for (const Camera& camera : reference.cameras) names.push_back(camera.name);
+    for (const Camera& camera : frame.cameras) names.push_back(camera.name);
     const std::vector<ImageGaussians> images =
-        BuildFrameImageGaussians(reference.images, {}, options.image, names);
-    return ComputeModelReferenceColors(fine.vertices, normals, reference.cameras, images, visible,
+        BuildFrameImageGaussians(frame.images, {}, options.image, names);
+    return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
                                        options.sigma_hat, options.energy.overlap,
                                        options.energy.reach_sigmas);
   }
-  return ComputeReferenceColors(fine.vertices, normals, reference.cameras, reference.images,
-                                visible, options.image.color_space, options.sigma_hat);
+  return ComputeReferenceColors(fine.vertices, normals, frame.cameras, frame.images, visible,
+                                options.image.color_space, options.sigma_hat);
 }
 
 namespace {
@@ -162,8 +166,9 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
   }
   if (options.energy.consensus.passes > 1) {
-    summary.energy_start = energy->Evaluate(start, nullptr);
-    summary.ls_cost_start = LeastSquaresCost(energy, start);
+    // Both ends by the same sum: the solver's own (Ceres') may differ from it in the last digit.
+    EvaluateEnergyAndCost(energy, start, &summary.energy_start, &summary.ls_cost_start);
+    EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
   }
   return summary;
 }
@@ -233,8 +238,9 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = SolveFrameEnergy(&energy, options, &k);
   if (coarse_k.size() > 0) {
-    result.summary.energy_start = energy.Evaluate(initial, nullptr);
-    result.summary.ls_cost_start = LeastSquaresCost(&energy, initial);
+    EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
+                          &result.summary.ls_cost_start);
+    EvaluateEnergyAndCost(&energy, k, &result.summary.energy_end, &result.summary.ls_cost_end);
     result.summary.iterations += coarse.iterations;
     result.summary.evaluations += coarse.evaluations;
     result.summary.seconds += coarse.seconds;

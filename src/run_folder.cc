@@ -20,7 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kSubfolders[] = {"meshes", "k", "traces", "frames"};
+const char* const kSubfolders[] = {"meshes", "k", "traces", "frames", "colors"};
 
 // Holds an exclusive flock on `path` (created if missing) while it lives.
 class FileLock {
@@ -58,6 +58,10 @@ bool FrameDone(const FrameFiles& files) {
 }
 
 std::string ReferenceColorsPath(const std::string& out) { return out + "/reference_colors.txt"; }
+std::string FollowedColorsFolder(const std::string& out) { return out + "/colors"; }
+std::string FollowedColorsPath(const std::string& out, const std::string& frame) {
+  return FollowedColorsFolder(out) + "/" + frame + ".txt";
+}
 std::string EvalFolder(const std::string& out) { return out + "/eval"; }
 std::string ExportFolder(const std::string& out) { return out + "/export"; }
 

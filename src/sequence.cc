@@ -1,5 +1,6 @@
 #include "finecap/sequence.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -7,6 +8,7 @@
 
 #include "finecap/ground_truth.h"
 #include "finecap/metrics.h"
+#include "finecap/scene_scale.h"
 #include "finecap/solver_trace.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
@@ -64,6 +66,33 @@ void RequireSameRecipe(const ReferenceColors& saved, const SequenceOptions& opti
               ", but the config asks for " + ColorSpaceName(refine.image.color_space) + ", " +
               std::to_string(refine.sigma_hat) + " and " + EnumToString(refine.reference_colors) +
               ": use another output folder");
+}
+
+// Whether the colours are taken at the refined reference surface: only when the similarity
+// compares colours, since consensus would refine the reference frame for nothing.
+bool TakesColorsAtRefinedSurface(const SequenceOptions& options) {
+  return options.colors.reference_surface == ReferenceSurface::kRefined &&
+         options.refine.energy.similarity != SimilarityType::kConsensus;
+}
+
+// Whether each frame's colours follow the ones before (pointless under consensus).
+bool FollowsColors(const SequenceOptions& options) {
+  return options.colors.following() &&
+         options.refine.energy.similarity != SimilarityType::kConsensus;
+}
+
+// The reference frame's colours, at its coarse or first refined surface.
+ReferenceColors ComputeReferenceFrameColors(const SequenceModel& model,
+                                            const SequenceOptions& options, Capture* capture,
+                                            const FrameInput& reference) {
+  if (!TakesColorsAtRefinedSurface(options)) {
+    return ComputeSequenceColors(model, reference, options.refine);
+  }
+  const RefineOptions pass =
+      ReferencePassOptions(options.refine, *capture, options.reference_frame);
+  // The consensus similarity takes its colours from the frame itself: none are passed in.
+  const FrameResult refined = RefineFrame(model, ReferenceColors{}, reference, pass);
+  return ComputeSurfaceColors(refined.refined, reference, options.refine);
 }
 
 // The refined vertices outside and inside the capture's textureless region.
@@ -158,11 +187,12 @@ class SequenceRun {
         log_(out, capture->frame_names(), options.mesh_format),
         model_(capture->ReadCoarseMesh(0), capture->vertex_mask(), options.refine,
                capture->mesh_path(0)),
-        colors_(LoadColors()),
+        reference_colors_(LoadColors()),
         regions_(SplitByTexture(model_, *capture)),
         reader_(capture, options.skip_unreadable_cameras) {}
 
   void Run(const FrameRange& frames, SequenceResult* result) {
+    if (!FollowsColors(options_)) RequireNoFollowedColors();
     ReportProblemSize(frames);
     double sum_coarse2 = 0.0, sum_refined2 = 0.0;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
@@ -204,11 +234,54 @@ class SequenceRun {
     FrameInput first = ReadFrameInput(capture_, frames.begin);
     TakeHeldOutViews(options_.held_out_cameras, &first);  // Refine never sees them.
     observer_->Starting(frames.size(), first,
-                        EstimateProblemSize(model_, colors_, first, options_.refine));
+                        EstimateProblemSize(model_, reference_colors_, first, options_.refine));
   }
 
   bool Done(int frame) const {
     return FrameDone(FrameFilesIn(out_, capture_->frame_name(frame), options_.mesh_format));
+  }
+
+  // A folder whose frames followed their colours cannot be continued with fixed colours.
+  void RequireNoFollowedColors() const {
+    const std::string folder = FollowedColorsFolder(out_);
+    Require(!fs::exists(folder) || fs::is_empty(folder), folder,
+            "holds the colours of a run with model.follow_colors, but this config keeps the "
+            "colours fixed: use another output folder");
+  }
+
+  // The colours `frame` is refined with: the reference colours, or, when they follow the
+  // sequence, those that the frame before left in the run folder.
+  ReferenceColors ColorsFor(int frame) const {
+    if (!FollowsColors(options_) || frame <= options_.reference_frame) return reference_colors_;
+    const std::string& previous = capture_->frame_name(frame - 1);
+    Require(Done(frame - 1), out_,
+            "model.follow_colors: frame " + capture_->frame_name(frame) +
+                " follows the colours that frame " + previous +
+                " leaves, which is not done here; following is sequential: refine the frames in "
+                "order from the reference frame, without shards");
+    const std::string path = FollowedColorsPath(out_, previous);
+    Require(fs::exists(path), path,
+            "is missing: frame " + previous +
+                " was refined without model.follow_colors; use another output folder");
+    ReferenceColors colors = ReadReferenceColors(path, model_.num_fine_vertices());
+    const std::string wanted = FollowedColorRecipe(options_);
+    Require(
+        colors.recipe == wanted, path,
+        "was made with " + RecipeDifference(colors.recipe, wanted) + ": use another output folder");
+    return colors;
+  }
+
+  // Saves the colours the frame after `name` is refined with: `used` followed towards the
+  // colours of the frame's refined surface, or `used` as it was when the frame was flagged worse.
+  void SaveFollowedColors(const std::string& name, const ReferenceColors& used,
+                          const FrameInput& input, const FrameResult& result, bool worse) const {
+    ReferenceColors next = used;
+    if (!worse) {
+      next = FollowColors(used, ComputeSurfaceColors(result.refined, input, options_.refine),
+                          reference_colors_, options_.colors);
+    }
+    next.recipe = FollowedColorRecipe(options_);
+    WriteReferenceColors(FollowedColorsPath(out_, name), next);
   }
 
   // Starts reading the first frame after `frame` that is still to do.
@@ -230,15 +303,20 @@ class SequenceRun {
         TakeHeldOutViews(options_.held_out_cameras, &input);
     ReadAheadAfter(frame, frames);
     const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
+    const ReferenceColors colors = ColorsFor(frame);
     FrameResult result = warm_start.size() > 0
-                             ? RefineFrameFrom(model_, colors_, input, options_.refine, warm_start)
-                             : RefineFrame(model_, colors_, input, options_.refine);
+                             ? RefineFrameFrom(model_, colors, input, options_.refine, warm_start)
+                             : RefineFrame(model_, colors, input, options_.refine);
     if (result.num_surface_gaussians == 0) observer_->NothingToRefine(name);
 
     FrameStats stats = MakeFrameStats(name, options_.refine, result);
     for (const SkippedCamera& camera : skipped) stats.skipped_cameras.push_back(camera.camera);
     ScoreInHeldOutViews(options_, model_, input, held_out, &result, &stats);
     AddGroundTruthErrors(*capture_, model_, input.coarse, frame, regions_, result, &stats);
+    // Before the record, which marks the frame done: a done frame always has them.
+    if (FollowsColors(options_) && frame >= options_.reference_frame) {
+      SaveFollowedColors(name, colors, input, result, stats.worse || result.worse);
+    }
     WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
                start, log_);
     return stats;
@@ -250,7 +328,7 @@ class SequenceRun {
   SequenceObserver* observer_;
   const StatsLog log_;
   const SequenceModel model_;
-  const ReferenceColors colors_;
+  const ReferenceColors reference_colors_;
   const Regions regions_;
   FrameReadAhead reader_;
 };
@@ -259,6 +337,7 @@ class SequenceRun {
 
 void SequenceOptions::Check() const {
   refine.Check();
+  colors.Check();
   held_out_score.Check();
   Require(reference_frame >= 0, "SequenceOptions::reference_frame",
           "must be >= 0, got " + std::to_string(reference_frame));
@@ -286,7 +365,51 @@ std::string ReferenceColorRecipe(const SequenceOptions& options) {
   for (size_t c = 0; c < options.held_out_cameras.size(); ++c) {
     recipe << (c == 0 ? "" : ",") << options.held_out_cameras[c];
   }
+  // Only when refined, so that the recipes of files saved before the choice existed still fit.
+  if (TakesColorsAtRefinedSurface(options)) {
+    recipe << " reference_surface=refined reg_rings=" << refine.energy.reg_rings;
+  }
   return recipe.str();
+}
+
+std::string FollowedColorRecipe(const SequenceOptions& options) {
+  std::ostringstream recipe;
+  recipe.precision(17);
+  recipe << ReferenceColorRecipe(options) << " follow_colors=" << options.colors.follow_colors
+         << " follow_anchor=" << options.colors.follow_anchor;
+  return recipe.str();
+}
+
+RefineOptions ReferencePassOptions(const RefineOptions& configured, const Capture& capture,
+                                   int reference_frame) {
+  RefineOptions pass;
+  pass.subdivision_levels = configured.subdivision_levels;
+  pass.energy.reg_rings = configured.energy.reg_rings;
+  pass.energy.consensus.patch_rings =
+      std::min(pass.energy.consensus.patch_rings, pass.energy.reg_rings);
+  pass.solver.num_threads = configured.solver.num_threads;
+  ResolveSceneScaleDefaults(capture, reference_frame, &pass);
+  return pass;
+}
+
+ReferenceColors FollowColors(const ReferenceColors& previous, const ReferenceColors& frame,
+                             const ReferenceColors& reference,
+                             const ReferenceColorOptions& options) {
+  const size_t n = reference.colors.size();
+  Require(previous.colors.size() == n && frame.colors.size() == n, "FollowColors",
+          "colours of " + std::to_string(previous.colors.size()) + " and " +
+              std::to_string(frame.colors.size()) + " vertices for a reference of " +
+              std::to_string(n));
+  const float rate = static_cast<float>(options.follow_colors);
+  const float anchor = static_cast<float>(options.follow_anchor);
+  ReferenceColors next = previous;
+  for (size_t v = 0; v < n; ++v) {
+    if (!reference.valid[v]) continue;
+    Eigen::Vector3f color = previous.colors[v];
+    if (frame.valid[v]) color += rate * (frame.colors[v] - color);
+    next.colors[v] = color + anchor * (reference.colors[v] - color);
+  }
+  return next;
 }
 
 ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
@@ -304,7 +427,7 @@ ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
   FrameInput reference =
       ReadFrameInput(capture, options.reference_frame, options.skip_unreadable_cameras, skipped);
   TakeHeldOutViews(options.held_out_cameras, &reference);  // Held-out cameras colour nothing.
-  ReferenceColors colors = ComputeSequenceColors(model, reference, options.refine);
+  ReferenceColors colors = ComputeReferenceFrameColors(model, options, capture, reference);
   colors.recipe = ReferenceColorRecipe(options);
   WriteReferenceColors(path, colors);
   // As saved: every run and shard on this folder then starts from the very same colours.

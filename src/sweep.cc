@@ -14,15 +14,13 @@ Eigen::MatrixXd SweepCosts(FrameEnergy* energy, const Eigen::VectorXd& displacem
   const int n = energy->num_parameters();
   Eigen::MatrixXd costs = Eigen::MatrixXd::Zero(n, displacements.size());
   const auto& blocks = term.residual_blocks();
-  std::vector<double> residuals;
+  std::vector<double> block_costs;
   for (int j = 0; j < displacements.size(); ++j) {
-    term.PrepareResiduals(Eigen::VectorXd::Constant(n, displacements[j]), false);
+    term.BlockCosts(Eigen::VectorXd::Constant(n, displacements[j]), &block_costs);
+    // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
     for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
-      residuals.resize(blocks[b].num_residuals);
-      term.BlockResiduals(b, residuals.data(), nullptr);
-      double cost = 0.0;
-      for (double r : residuals) cost += r * r;
-      for (int s : blocks[b].parameters) costs(s, j) += cost / blocks[b].parameters.size();
+      for (int s : blocks[b].parameters)
+        costs(s, j) += block_costs[b] / blocks[b].parameters.size();
     }
   }
   return costs;

@@ -154,8 +154,8 @@ TEST(ConfigOptionsTest, ChoicesAreTheNamesOfTheirEnums) {
     schema.Set("solver.type", name, "--set");
     EXPECT_EQ(EnumToString(config.refine.solver.type), name);
   }
-  schema.Set("solver.linear_solver", "cgnr", "--set");
-  EXPECT_EQ(config.refine.solver.linear_solver, LinearSolverType::kCgnr);
+  schema.Set("solver.linear_solver", "sparse_normal_cholesky", "--set");
+  EXPECT_EQ(config.refine.solver.linear_solver, LinearSolverType::kSparseNormalCholesky);
   schema.Set("energy.overlap", "patch", "--set");
   EXPECT_EQ(config.refine.energy.overlap, OverlapForm::kPatch);
   schema.Set("image_gaussians.color_space", "lab", "--set");

@@ -110,6 +110,35 @@ TEST_P(ScalarAndResidualsTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
   EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
 }
 
+// BlockCosts gives each block's sum of squares, at a k the same for every Gaussian (the sweep's
+// samples, where consensus reads each row's colour once) as at any other.
+TEST_P(ScalarAndResidualsTest, BlockCostsAreEachBlocksSumOfSquares) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options(GetParam(), "printed"));
+  SimilarityTerm& term = energy.similarity();
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  ASSERT_GT(num_blocks, 10);
+  for (const Eigen::VectorXd& k :
+       {Eigen::VectorXd(Eigen::VectorXd::Constant(energy.num_parameters(), 0.003)),
+        RandomK(energy.num_parameters(), 0.005, 4)}) {
+    std::vector<double> costs;
+    term.BlockCosts(k, &costs);
+    ASSERT_EQ(costs.size(), static_cast<size_t>(num_blocks));
+    term.PrepareResiduals(k, false);
+    double total = 0.0;
+    for (int b = 0; b < num_blocks; ++b) {
+      std::vector<double> residuals(term.residual_blocks()[b].num_residuals);
+      term.BlockResiduals(b, residuals.data(), nullptr);
+      double sum = 0.0;
+      for (double r : residuals) sum += r * r;
+      EXPECT_NEAR(costs[b], sum, 1e-12 * (1.0 + sum)) << "block " << b;
+      total += sum;
+    }
+    EXPECT_GT(total, 0.0);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(SumOfSquares, ScalarAndResidualsTest,
                          ::testing::Values("surface_color", "consensus"));
 

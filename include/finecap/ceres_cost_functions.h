@@ -15,8 +15,8 @@
 
 namespace finecap {
 
-// Calls SimilarityTerm::PrepareResiduals at every evaluation point that differs from the last one
-// prepared (or needs Jacobians the last preparation did not compute). `k` is the vector whose
+// Calls SimilarityTerm::PrepareResiduals, with Jacobians, at every evaluation point that differs
+// from the last one prepared. `k` is the vector whose
 // entries are the problem's parameter blocks: Ceres has written the point there when it calls.
 // Time spent is added to *seconds.
 class SharedEvaluationCallback : public ceres::EvaluationCallback {
@@ -29,7 +29,6 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
   const Eigen::VectorXd* k_;
   double* seconds_;
   Eigen::VectorXd prepared_;  // The point of the last preparation (empty before the first).
-  bool have_jacobians_ = false;
 };
 
 // Residual block `block` of the similarity, one 1-D parameter block per k_s it depends on. Its
@@ -43,6 +42,29 @@ class SimilarityBlockCost : public ceres::CostFunction {
  protected:
   const SimilarityTerm& term_;
   int block_;
+};
+
+// The same residual block, reduced for the solver to at most p + 1 residuals for its p
+// parameters: with J = Q R (Q with orthonormal columns), the residuals Q^T r and |r - Q Q^T r|, of
+// Jacobian R and 0. Their sum of squares is |r|^2, their gradient J'^T r' = J^T r and their
+// Gauss-Newton matrix J'^T J' = J^T J, so the linear model |r + J dk|^2 that Levenberg-Marquardt
+// and dogleg steps are taken on is the same, and so is every step: exactly, up to rounding. A
+// consensus or surface_color block of one Gaussian seen by 8 cameras has 3 * 8 * 7 residuals and
+// one parameter; reduced, Ceres assembles and multiplies two rows instead of 168.
+//
+// The Jacobian returned is R, not the derivative of the residuals returned (those are not a
+// differentiable function of k): check Jacobians on SimilarityBlockCost. Without Jacobians the
+// residuals are (|r|, 0, ...): Ceres uses a point's residuals alone only for its cost.
+class ReducedSimilarityBlockCost : public ceres::CostFunction {
+ public:
+  ReducedSimilarityBlockCost(const SimilarityTerm& term, int block);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const SimilarityTerm& term_;
+  int block_;
+  int num_full_residuals_;
 };
 
 // The same residual block, but preparing the term itself at the parameters it is given (the

@@ -13,6 +13,7 @@
 #include "finecap/heldout_score.h"
 #include "finecap/io/frame_range.h"
 #include "finecap/refine.h"
+#include "finecap/sequence.h"
 #include "finecap/shard.h"
 #include "finecap/synth.h"
 
@@ -84,6 +85,8 @@ struct Config {
   // Index, in the capture's sorted frame list, of the frame whose images colour the surface
   // Gaussians. Default 0 (the paper: "typically the first frame").
   int reference_frame = 0;
+  // Where the reference colours are taken and whether they follow the sequence (section model).
+  ReferenceColorOptions colors;
   // Everything the refinement of a frame uses (sections model, image_gaussians, visibility,
   // energy, solver, refine).
   RefineOptions refine;

@@ -147,9 +147,15 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
                                                                const std::vector<Camera>& cameras,
                                                                const VisibilityOptions& options);
 
-// The colours of the fine vertices, from the reference frame's images.
+// The colours of the fine vertices, from the reference frame's images at its coarse surface.
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
                                       const RefineOptions& options);
+
+// The colours of the vertices of `fine` (a frame's fine mesh, e.g. its refined surface), from
+// that frame's images, as ComputeSequenceColors takes them: visibility, camera and method by
+// `options`.
+ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
+                                     const RefineOptions& options);
 
 // A frame made ready to solve: its fine mesh, the image Gaussians and the energy over them.
 struct PreparedFrame {

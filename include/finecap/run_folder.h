@@ -9,6 +9,7 @@
 //   frames/<frame>.json        the frame's statistics record (frame_stats.h), written last
 //   stats.jsonl                every done frame's record, in frame order
 //   reference_colors.txt       the sequence's reference colours (surface_gaussians.h)
+//   colors/<frame>.txt         with model.follow_colors: the colours the frame after it uses
 //   eval/, export/             what finecap eval and finecap export make of the run
 //
 // A frame is done when its mesh, its displacement and its stats record all exist. Each is written
@@ -46,6 +47,9 @@ bool FrameDone(const FrameFiles& files);
 
 // Where the run folder `out` keeps its reference colours, and what eval and export write.
 std::string ReferenceColorsPath(const std::string& out);
+// Where the colours followed up to `frame` are kept (model.follow_colors), and their folder.
+std::string FollowedColorsPath(const std::string& out, const std::string& frame);
+std::string FollowedColorsFolder(const std::string& out);
 std::string EvalFolder(const std::string& out);
 std::string ExportFolder(const std::string& out);
 

@@ -25,8 +25,44 @@
 #include "finecap/problem_size.h"
 #include "finecap/refine.h"
 #include "finecap/run_folder.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
+
+// Where the reference frame colours the surface Gaussians.
+enum class ReferenceSurface {
+  kCoarse,   // At the reference frame's input (coarse) surface, as the paper did.
+  kRefined,  // At the reference frame refined first by a similarity that needs no colours.
+};
+const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface);
+
+// How the colours that surface_color and paper compare with the images are taken and kept over a
+// sequence. The consensus similarity uses no such colours, and under it these options do nothing
+// (the colours are then taken at the coarse surface, for the figures that need some).
+struct ReferenceColorOptions {
+  // With kRefined, the reference frame is first refined with the consensus similarity and
+  // finecap's defaults for everything that a similarity tunes (ReferencePassOptions), and the
+  // colours are taken at that refined surface: at a coarse surface they belong to the wrong
+  // surface points wherever the surface has detail the input lacks. Default kRefined.
+  ReferenceSurface reference_surface = ReferenceSurface::kRefined;
+  // Rate r at which the colours follow the sequence, in [0, 1]; 0 (default) keeps the reference
+  // colours for every frame (the paper). After each refined frame from the reference frame on
+  // that the run did not flag worse, every colour its refined surface shows (where a camera saw
+  // the vertex) is blended in, eta <- eta + r (eta_frame - eta), so slow changes of lighting or
+  // appearance are followed. Following is sequential: frame t uses the colours that frame t - 1
+  // left, saved in the run folder (so a resumed run continues exactly), and a frame whose
+  // predecessor is not done there is refused.
+  double follow_colors = 0.0;
+  // Pull of every followed colour back towards its reference colour after each update,
+  // eta <- eta + a (eta_reference - eta), in [0, 1]: what keeps the errors of one frame's surface
+  // from accumulating frame after frame (drift). A steady change of the images is followed to
+  // the share r (1 - a) / (r + a - r a) of it; the reference colour remains the anchor.
+  // Default 0.1.
+  double follow_anchor = 0.1;
+
+  bool following() const { return follow_colors > 0.0; }
+  void Check() const;
+};
 
 struct SequenceOptions {
   // How each frame is refined. Its lengths should be resolved from the scene first
@@ -35,6 +71,8 @@ struct SequenceOptions {
   // The frame whose images colour the surface Gaussians of every frame (model.reference_frame).
   // Default 0.
   int reference_frame = 0;
+  // How the colours are taken and kept over the sequence.
+  ReferenceColorOptions colors;
   // Cameras that refinement never sees (not even for the reference colours): each frame's result
   // and input are scored in them, and with refine.keep_input_if_worse a result that scores worse
   // than its input is replaced by the input. Default none.
@@ -54,8 +92,30 @@ struct SequenceOptions {
 // one file of reference colours.
 std::string ReferenceColorRecipe(const SequenceOptions& options);
 
+// The options with which the reference frame is refined before it colours the surface (with
+// ReferenceSurface::kRefined): finecap's defaults (the consensus similarity, which needs no
+// colours), their lengths resolved for `capture`'s scene, with the configured subdivision and
+// regulariser neighbourhood (the sequence's model is built with those) and threads. Not the
+// configured similarity's own settings: those of surface_color (a 35 degree view cap, no sweep,
+// chromaticity) leave most patches with fewer than the two cameras consensus needs.
+RefineOptions ReferencePassOptions(const RefineOptions& configured, const Capture& capture,
+                                   int reference_frame);
+
+// What the followed colours saved after a frame depend on: ReferenceColorRecipe and the two
+// follow options.
+std::string FollowedColorRecipe(const SequenceOptions& options);
+
+// `previous` (the colours frame t used) updated by frame t's own colours `frame` (taken at its
+// refined surface) and pulled towards `reference`, as ReferenceColorOptions says; only where
+// `reference` is valid. Returns `previous` pulled towards the reference only, where `frame` has
+// no valid colour.
+ReferenceColors FollowColors(const ReferenceColors& previous, const ReferenceColors& frame,
+                             const ReferenceColors& reference,
+                             const ReferenceColorOptions& options);
+
 // The reference colours saved at `path`, or, when there is no such file, those of the reference
-// frame, computed, saved there with their recipe and read back (so that a run uses exactly what a
+// frame (at its coarse or refined surface, options.colors.reference_surface), computed, saved
+// there with their recipe and read back (so that a run uses exactly what a
 // later resumed run or shard reads). A saved file made with another recipe throws Error naming
 // `path` and the fields that differ (a file saved before recipes were is checked on its colour
 // space, sigma_hat and method). Cameras skipped in the reference frame go to *skipped (may be

@@ -48,8 +48,11 @@ struct SolverOptions {
 
   // Ceres only: trust-region strategy.
   TrustRegionType trust_region = TrustRegionType::kLevenbergMarquardt;
-  // Ceres only: the linear solver; kCgnr is the iterative option.
-  LinearSolverType linear_solver = LinearSolverType::kSparseNormalCholesky;
+  // Ceres only: the linear solver. Conjugate gradients by default: the normal equations are
+  // diagonal but for the regulariser, so a few products solve them to the accuracy the step
+  // needs, at a fifth of the time of SuiteSparse's factorisation on synth_skirt and to the same
+  // error on every capture measured (README, "Where a frame's time goes").
+  LinearSolverType linear_solver = LinearSolverType::kCgnr;
 
   // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
   // are scaled from it). Default 0.5 mm; a refinement makes it follow from the scene unless set
@@ -92,6 +95,11 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
 
 // 1/2 sum of squared residuals of the least-squares form at k (similarity and regulariser).
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k);
+
+// The energy E and the least-squares cost at k, with one evaluation of the similarity when it
+// is a least-squares term (E = -cost), two otherwise.
+void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double* energy_value,
+                           double* cost);
 
 }  // namespace finecap
 

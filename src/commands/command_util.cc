@@ -127,6 +127,7 @@ SequenceOptions SequenceOptionsOf(const Config& config) {
   SequenceOptions options;
   options.refine = config.refine;
   options.reference_frame = config.reference_frame;
+  options.colors = config.colors;
   options.held_out_cameras = config.validation.cameras;
   options.held_out_score = config.validation.score;
   options.skip_unreadable_cameras = config.capture.skip_unreadable_cameras;

@@ -148,33 +148,37 @@ void ConsensusSimilarity::BuildTables(double k_max) {
   node_step_ = 2.0 * k_max / (num_nodes_ - 1);
   node_k0_ = -k_max;
   table_.resize(views_.size());
-  table_derivative_.resize(views_.size());
   for (size_t c = 0; c < views_.size(); ++c) {
     const EnergyView& view = views_[c];
     const int num_rows = static_cast<int>(view.pairs.surface_ids.size());
     table_[c].resize(long(num_rows) * num_nodes_);
-    table_derivative_[c].resize(long(num_rows) * num_nodes_);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int row = 0; row < num_rows; ++row) {
       const int j = view.pairs.surface_ids[row];
       for (int g = 0; g < num_nodes_; ++g) {
         const long entry = long(row) * num_nodes_ + g;
         Eigen::Vector3d derivative;
-        table_[c][entry] = ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_, form_,
-                                             surface_.colors[j].cast<double>(), &derivative)
-                               .cast<float>();
-        table_derivative_[c][entry] = derivative.cast<float>();
+        table_[c][entry].color =
+            ImageColorOfPairs(view, surface_, row, node_k0_ + g * node_step_, form_,
+                              surface_.colors[j].cast<double>(), &derivative)
+                .cast<float>();
+        table_[c][entry].slope = (node_step_ * derivative).cast<float>();
       }
     }
   }
 }
 
 void ConsensusSimilarity::PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                                      std::vector<Eigen::Vector3d>* derivatives) const {
+                                      std::vector<Eigen::Vector3d>* derivatives,
+                                      const RowColors* row_colors) const {
   const int c = cameras_[a];
   const std::vector<int>& rows = rows_[a];
   const int n = static_cast<int>(rows.size());
   colors->resize(n);
+  if (row_colors != nullptr) {
+    for (int m = 0; m < n; ++m) (*colors)[m] = (*row_colors)[c][rows[m]];
+    return;
+  }
   if (derivatives != nullptr) derivatives->resize(n);
   const EnergyView& view = views_[c];
   const double centre_shape = shape_[view.pairs.surface_ids[rows[0]]];
@@ -191,11 +195,11 @@ Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
   const double x = std::clamp((k - node_k0_) / node_step_, 0.0, num_nodes_ - 1.0);
   const int g = std::min(static_cast<int>(x), num_nodes_ - 2);
   const double t = x - g, t2 = t * t, t3 = t2 * t;
-  const long entry = long(row) * num_nodes_ + g;
-  const Eigen::Vector3d p0 = table_[c][entry].cast<double>();
-  const Eigen::Vector3d p1 = table_[c][entry + 1].cast<double>();
-  const Eigen::Vector3d m0 = node_step_ * table_derivative_[c][entry].cast<double>();
-  const Eigen::Vector3d m1 = node_step_ * table_derivative_[c][entry + 1].cast<double>();
+  const TableNode* node = &table_[c][long(row) * num_nodes_ + g];
+  const Eigen::Vector3d p0 = node[0].color.cast<double>();
+  const Eigen::Vector3d p1 = node[1].color.cast<double>();
+  const Eigen::Vector3d m0 = node[0].slope.cast<double>();
+  const Eigen::Vector3d m1 = node[1].slope.cast<double>();
   if (derivative != nullptr) {
     const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
     derivative->setZero();
@@ -228,12 +232,13 @@ Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
   return (variance / (camera_begin_[b + 1] - camera_begin_[b])).cwiseSqrt();
 }
 
-void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
+void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian,
+                                  const RowColors* row_colors) const {
   const int num_cameras = camera_begin_[b + 1] - camera_begin_[b];
   std::vector<std::vector<Eigen::Vector3d>> z(num_cameras), dz(num_cameras);
   std::vector<Eigen::Vector3d> q, dq;
   for (int a = 0; a < num_cameras; ++a) {
-    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr);
+    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr, row_colors);
     Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor,
               !options_.gain_per_channel, &z[a], &dz[a]);
   }
@@ -295,6 +300,36 @@ void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_j
   for (int b = 0; b < num_blocks; ++b) {
     BlockAt(b, k[blocks_[b].parameters[0]], &residuals_[residual_begin_[b]],
             with_jacobians ? &jacobians_[residual_begin_[b]] : nullptr);
+  }
+}
+
+void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
+  const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
+  if (!uniform) {
+    SimilarityTerm::BlockCosts(k, costs);
+    return;
+  }
+  RowColors row_colors(views_.size());
+  for (size_t c = 0; c < views_.size(); ++c) {
+    const int num_rows = static_cast<int>(views_[c].pairs.surface_ids.size());
+    row_colors[c].resize(num_rows);
+#pragma omp parallel for schedule(static)
+    for (int row = 0; row < num_rows; ++row)
+      row_colors[c][row] = Interpolate(c, row, k[0], nullptr);
+  }
+  const int num_blocks = static_cast<int>(blocks_.size());
+  costs->resize(num_blocks);
+#pragma omp parallel
+  {
+    std::vector<double> residuals;
+#pragma omp for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      residuals.resize(blocks_[b].num_residuals);
+      BlockAt(b, k[0], residuals.data(), nullptr, &row_colors);
+      double cost = 0.0;
+      for (double r : residuals) cost += r * r;
+      (*costs)[b] = cost;
+    }
   }
 }
 

@@ -64,6 +64,10 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+  bool IsLeastSquares() const override { return true; }
+  // Where every k_s is the same and the patches are flat (the plane sweep's samples), each
+  // pair-list row's colour is interpolated once instead of once for every patch it belongs to.
+  void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
 
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
   // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.
@@ -76,17 +80,22 @@ class ConsensusSimilarity : public SimilarityTerm {
  private:
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
+  // Colours of every row of every camera's pair list at one k, [c][row].
+  using RowColors = std::vector<std::vector<Eigen::Vector3d>>;
   // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
-  // member displaced by k along its own normal, interpolated in the tables.
+  // member displaced by k along its own normal, interpolated in the tables; or, given
+  // `row_colors` (taken at this k, flat patches), read from them.
   void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                   std::vector<Eigen::Vector3d>* derivatives) const;
+                   std::vector<Eigen::Vector3d>* derivatives,
+                   const RowColors* row_colors = nullptr) const;
   // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk.
   Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
   // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
   // their derivatives.
-  void BlockAt(int b, double k, double* residuals, double* jacobian) const;
+  void BlockAt(int b, double k, double* residuals, double* jacobian,
+               const RowColors* row_colors = nullptr) const;
 
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
@@ -105,9 +114,14 @@ class ConsensusSimilarity : public SimilarityTerm {
   // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
   double node_k0_ = 0.0, node_step_ = 1.0;
   int num_nodes_ = 0;
-  // In single precision: the tables are the similarity's largest part (~24 bytes per node), and
-  // colours carry 8 bits.
-  std::vector<std::vector<Eigen::Vector3f>> table_, table_derivative_;
+  // A node's colour and its slope (dcolour/dk times node_step_, the Hermite tangent) side by
+  // side: an interpolation reads two neighbouring nodes, 48 contiguous bytes. In single
+  // precision: the tables are the similarity's largest part, and colours carry 8 bits.
+  struct TableNode {
+    Eigen::Vector3f color;
+    Eigen::Vector3f slope;
+  };
+  std::vector<std::vector<TableNode>> table_;
   Eigen::VectorXd shape_;
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].

@@ -48,6 +48,7 @@ class SurfaceColorSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+  bool IsLeastSquares() const override { return true; }
 
   // The residual r_sc of surface Gaussian `row` of `camera`'s pair list, and dr_sc/dk_s.
   void Residual(int camera, int row, double k, Eigen::Vector3d* residual,

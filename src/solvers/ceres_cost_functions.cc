@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <utility>
 
+#include <Eigen/QR>
+
 #include "solvers/solvers_internal.h"
 
 namespace finecap {
@@ -11,20 +13,16 @@ SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const E
                                                    double* seconds)
     : term_(term), k_(k), seconds_(seconds) {}
 
-void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
+void SharedEvaluationCallback::PrepareForEvaluation(bool /*evaluate_jacobians*/,
                                                     bool new_evaluation_point) {
-  // Ceres' trust region with bounds evaluates each new point up to three times: the projected
-  // line search's first trial (with Jacobians), the candidate's cost (residuals only), and, once
-  // the step is taken, the Jacobians again; only the last says it is the same point. Comparing
-  // the point itself lets one preparation with Jacobians serve all three. A residual-only
-  // preparation cannot serve a later Jacobian request at the same point.
-  const bool same_point =
-      !new_evaluation_point || (prepared_.size() == k_->size() && prepared_ == *k_);
-  if (same_point && (have_jacobians_ || !evaluate_jacobians)) return;
+  // Each step's candidate is evaluated for its cost alone and, once the step is taken, again
+  // with Jacobians at the same point (Ceres says so); a step is mostly taken, so one preparation
+  // with Jacobians serves both. Comparing the point itself also catches a point Ceres evaluates
+  // again without saying so.
+  if (!new_evaluation_point || (prepared_.size() == k_->size() && prepared_ == *k_)) return;
   const internal::Stopwatch clock;
-  term_->PrepareResiduals(*k_, evaluate_jacobians);
+  term_->PrepareResiduals(*k_, true);
   prepared_ = *k_;
-  have_jacobians_ = evaluate_jacobians;
   *seconds_ += clock.Seconds();
 }
 
@@ -50,6 +48,62 @@ bool SimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* 
   for (int p = 0; p < num_parameters; ++p) {
     if (jacobians[p] == nullptr) continue;
     for (int r = 0; r < num_residuals(); ++r) jacobians[p][r] = jacobian[r * num_parameters + p];
+  }
+  return true;
+}
+
+ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& term, int block)
+    : term_(term), block_(block) {
+  const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
+  num_full_residuals_ = info.num_residuals;
+  const int num_parameters = static_cast<int>(info.parameters.size());
+  set_num_residuals(std::min(num_full_residuals_, num_parameters + 1));
+  mutable_parameter_block_sizes()->assign(num_parameters, 1);
+}
+
+bool ReducedSimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* residuals,
+                                          double** jacobians) const {
+  const int m = num_full_residuals_;
+  const int p = static_cast<int>(parameter_block_sizes().size());
+  thread_local Eigen::VectorXd r;
+  thread_local Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian;
+  r.resize(m);
+  if (m == num_residuals()) {  // Nothing to reduce: the block as it is.
+    jacobian.resize(m, p);
+    term_.BlockResiduals(block_, residuals, jacobians != nullptr ? jacobian.data() : nullptr);
+    if (jacobians == nullptr) return true;
+    for (int q = 0; q < p; ++q) {
+      if (jacobians[q] == nullptr) continue;
+      for (int i = 0; i < m; ++i) jacobians[q][i] = jacobian(i, q);
+    }
+    return true;
+  }
+  std::fill_n(residuals, num_residuals(), 0.0);
+  if (jacobians == nullptr) {
+    term_.BlockResiduals(block_, r.data(), nullptr);
+    residuals[0] = r.norm();
+    return true;
+  }
+  jacobian.resize(m, p);
+  term_.BlockResiduals(block_, r.data(), jacobian.data());
+  const double squared_norm = r.squaredNorm();
+  Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(p + 1, p);  // [R; 0].
+  Eigen::VectorXd along(p);                                   // Q^T r.
+  if (p == 1) {
+    const double length = jacobian.col(0).norm();
+    along[0] = length > 0.0 ? jacobian.col(0).dot(r) / length : 0.0;
+    reduced(0, 0) = length;
+  } else {
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(jacobian);
+    along = (qr.householderQ().transpose() * r).head(p);
+    reduced.topRows(p) = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+  }
+  for (int i = 0; i < p; ++i) residuals[i] = along[i];
+  // What of r no step can reduce; rounding may make the difference a hair negative.
+  residuals[p] = std::sqrt(std::max(0.0, squared_norm - along.squaredNorm()));
+  for (int q = 0; q < p; ++q) {
+    if (jacobians[q] == nullptr) continue;
+    for (int i = 0; i <= p; ++i) jacobians[q][i] = reduced(i, q);
   }
   return true;
 }

@@ -57,7 +57,7 @@ void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* probl
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
     blocks.clear();
     for (int s : term.residual_blocks()[b].parameters) blocks.push_back(&(*k)[s]);
-    problem->AddResidualBlock(new SimilarityBlockCost(term, b), nullptr, blocks);
+    problem->AddResidualBlock(new ReducedSimilarityBlockCost(term, b), nullptr, blocks);
   }
   AddSmoothnessResiduals(*energy, k, problem);
 }
@@ -73,12 +73,19 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
       options.trust_region == TrustRegionType::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   if (options.linear_solver == LinearSolverType::kCgnr) {
     ceres_options.linear_solver_type = ceres::CGNR;
+    // Conjugate gradients stop when the step's residual falls below eta times the right-hand
+    // side's. Ceres' 0.1 left the surface 0.4 % further from the truth than the exact step of
+    // the sparse Cholesky factorisation; at 0.01 it is level with it, for a few more products.
+    ceres_options.eta = 1e-2;
   } else if (options.linear_solver == LinearSolverType::kDenseQr) {
     ceres_options.linear_solver_type = ceres::DENSE_QR;
   } else {
     ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     ceres_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   }
+  // The bounds on k are wide (k_max): a step is projected onto them, without the projected line
+  // search Ceres would otherwise run, which costs a Jacobian evaluation at every candidate.
+  ceres_options.max_num_line_search_step_size_iterations = 0;
   ceres_options.logging_type = ceres::SILENT;
   return ceres_options;
 }
@@ -102,6 +109,10 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   ceres::Solve(ceres_options, &problem, &ceres_summary);
   VLOG(1) << ceres_summary.FullReport();
 
+  if (ceres_summary.IsSolutionUsable()) {  // Else Ceres' costs are not those of its start and end.
+    summary->ls_cost_start = ceres_summary.initial_cost;
+    summary->ls_cost_end = ceres_summary.final_cost;
+  }
   summary->iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
   summary->evaluations = ceres_summary.num_residual_evaluations;
   summary->termination = ceres::TerminationTypeToString(ceres_summary.termination_type);

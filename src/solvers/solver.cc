@@ -1,27 +1,30 @@
 #include "finecap/solver.h"
 
+#include <cmath>
+#include <vector>
+
 #include "finecap/util/error.h"
 #include "solvers/solvers_internal.h"
 
 namespace finecap {
 
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
-  SimilarityTerm& similarity = energy->similarity();
-  similarity.PrepareResiduals(k, false);
+  std::vector<double> block_costs;
+  energy->similarity().BlockCosts(k, &block_costs);
   double sum_of_squares = 0.0;
-  std::vector<double> residuals;
-  const auto& blocks = similarity.residual_blocks();
-  for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
-    residuals.resize(blocks[b].num_residuals);
-    similarity.BlockResiduals(b, residuals.data(), nullptr);
-    for (double r : residuals) sum_of_squares += r * r;
-  }
+  for (double cost : block_costs) sum_of_squares += cost;
   // The regulariser's residuals are 2 sqrt(w T) u (k_a - k_b): their half sum of squares is
   // w_reg * E_reg; the prior's, sqrt(p_s) k_s, give E_prior.
   const Eigen::VectorXd& prior = energy->prior_curvature();
   return 0.5 * sum_of_squares +
          energy->options().w_reg * energy->regularizer().Evaluate(k, nullptr) +
          0.5 * k.dot(prior.cwiseProduct(k));
+}
+
+void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double* energy_value,
+                           double* cost) {
+  *cost = LeastSquaresCost(energy, k);
+  *energy_value = energy->similarity().IsLeastSquares() ? -*cost : energy->Evaluate(k, nullptr);
 }
 
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {
@@ -31,8 +34,21 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   *k = k->cwiseMax(-k_max).cwiseMin(k_max);
   SolverSummary summary;
   summary.solver = EnumToString(options.type);
-  summary.ls_cost_start = LeastSquaresCost(energy, *k);
-  summary.energy_start = energy->Evaluate(*k, nullptr);
+  if (options.type == SolverType::kCeres && energy->similarity().IsLeastSquares() &&
+      k->size() > 0) {
+    // Ceres' own start and final costs are the least-squares cost, and so give E.
+    const Eigen::VectorXd start = *k;
+    summary.ls_cost_start = summary.ls_cost_end = std::nan("");
+    internal::SolveWithCeres(energy, options, k, &summary);
+    if (std::isnan(summary.ls_cost_start)) {
+      summary.ls_cost_start = LeastSquaresCost(energy, start);
+      summary.ls_cost_end = LeastSquaresCost(energy, *k);
+    }
+    summary.energy_start = -summary.ls_cost_start;
+    summary.energy_end = -summary.ls_cost_end;
+    return summary;
+  }
+  EvaluateEnergyAndCost(energy, *k, &summary.energy_start, &summary.ls_cost_start);
   if (options.type == SolverType::kCeres) {
     internal::SolveWithCeres(energy, options, k, &summary);
   } else if (options.type == SolverType::kGradientAscent) {
@@ -40,8 +56,7 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   } else {
     internal::SolveWithLbfgs(*energy, options, k, &summary);
   }
-  summary.energy_end = energy->Evaluate(*k, nullptr);
-  summary.ls_cost_end = LeastSquaresCost(energy, *k);
+  EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
   return summary;
 }
 

@@ -46,6 +46,14 @@ class SimilarityTerm {
   // residuals[r] for r < num_residuals; when `jacobian` is not null, jacobian[r * P + p] =
   // d residual r / d k of parameters[p], P = parameters.size().
   virtual void BlockResiduals(int block, double* residuals, double* jacobian) const = 0;
+
+  // costs[b] = the sum of squares of block b's residuals at k, for every block. Prepares the
+  // residuals at k (without Jacobians) and sums them; a term may know a faster way.
+  virtual void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs);
+
+  // True when Evaluate(k) is exactly minus half the sum of squares of the residuals at k: then
+  // the least-squares cost gives the similarity too, and a solver need not evaluate both.
+  virtual bool IsLeastSquares() const { return false; }
 };
 
 }  // namespace finecap

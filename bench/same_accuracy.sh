@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# Ceres against the paper's gradient ascent to the same accuracy on synth_skirt (8 cameras of
+# 1004 x 1004, ~10k surface Gaussians, the default energy), by the whole time of a frame (its
+# preparation, the sweep and both passes of the solve: stats.jsonl "seconds", so that a run's
+# one-off start does not dilute the ratio). Ceres with its defaults; the ascent with no function
+# tolerance and a ladder of iteration budgets; run after run in turn, so that a load from
+# elsewhere falls on all alike. The ascent's speed at Ceres' accuracy is read off the ladder:
+# the time per frame interpolated between the last budget that ends above Ceres' RMS error and
+# the first that ends at or below it.
+#
+#   bash bench/same_accuracy.sh   # 8 frames, 3 runs each; FRAMES=4 REPEATS=1 for a quick look;
+#                                 # BUDGETS="25 50 100 200 400" (most iterations per solve)
+#
+# Prints one "name: value" a line: ceres_frames_per_minute and ceres_rms_mm; per budget N
+# ascent_N_frames_per_minute and ascent_N_rms_mm; ascent_frames_per_minute_at_ceres_rms ("not
+# reached" when no budget gets there) and ceres_to_ascent_speed_ratio. Frames per minute are 60
+# over the median over the runs of the mean seconds per frame; RMS is over frames of the
+# per-frame RMS error of k against the truth.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+frames=${FRAMES:-8}
+repeats=${REPEATS:-3}
+budgets=${BUDGETS:-25 50 100 200 400}
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+[ -x build/finecap ] || bash scripts/build.sh >/dev/null
+build/finecap synth --config configs/synth_skirt.yaml --out "$work/capture" \
+  --set "synth.num_frames=$frames" >/dev/null
+
+rms_of() {  # stats.jsonl; RMS over frames of rms_refined_mm
+  grep -o '"rms_refined_mm": [0-9.eE+-]*' "$1" |
+    awk '{ s += $2 * $2; n += 1 } END { printf "%.4f", sqrt(s / n) }'
+}
+
+median() {
+  tr ' ' '\n' | grep . | sort -g |
+    awk '{ v[NR] = $1 } END { printf "%.3f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+
+run() {  # output folder, refine arguments...; prints the mean of the frames' seconds
+  local dir=$1
+  shift
+  rm -rf "$dir"
+  build/finecap refine --capture "$work/capture" --out "$dir" "$@" >/dev/null 2>&1
+  grep -o '"seconds": [0-9.eE+-]*' "$dir/stats.jsonl" |
+    awk '{ s += $2; n += 1 } END { printf "%.4f", s / n }'
+}
+
+declare -A seconds
+for ((i = 0; i < repeats; ++i)); do
+  seconds[ceres]+=" $(run "$work/ceres" --solver ceres)"
+  for n in $budgets; do
+    seconds[$n]+=" $(run "$work/ascent_$n" --solver gradient-ascent \
+      --set "solver.max_iterations=$n,solver.function_tolerance=0")"
+  done
+done
+
+ceres_seconds=$(echo "${seconds[ceres]}" | median)
+ceres_rms=$(rms_of "$work/ceres/stats.jsonl")
+echo "frames: $frames"
+echo "runs_each: $repeats"
+echo "ceres_frames_per_minute: $(echo "$ceres_seconds" | awk '{ printf "%.1f", 60 / $1 }')"
+echo "ceres_rms_mm: $ceres_rms"
+ladder=""
+for n in $budgets; do
+  s=$(echo "${seconds[$n]}" | median)
+  rms=$(rms_of "$work/ascent_$n/stats.jsonl")
+  echo "ascent_${n}_frames_per_minute: $(echo "$s" | awk '{ printf "%.1f", 60 / $1 }')"
+  echo "ascent_${n}_rms_mm: $rms"
+  ladder+="$s $rms"$'\n'
+done
+# Seconds per frame where the ladder first reaches Ceres' RMS, interpolated in RMS.
+at_target=$(printf '%s' "$ladder" | awk -v target="$ceres_rms" '
+  $2 <= target {
+    if (NR == 1 || previous_rms <= $2) { print $1; found = 1; exit }
+    print previous_s + ($1 - previous_s) * (previous_rms - target) / (previous_rms - $2)
+    found = 1; exit
+  }
+  { previous_s = $1; previous_rms = $2 }
+  END { if (!found) print "none" }')
+if [ "$at_target" = none ]; then
+  echo "ascent_frames_per_minute_at_ceres_rms: not reached"
+else
+  echo "ascent_frames_per_minute_at_ceres_rms: $(echo "$at_target" | awk '{ printf "%.1f", 60 / $1 }')"
+  echo "ceres_to_ascent_speed_ratio: $(echo "$at_target $ceres_seconds" | awk '{ printf "%.2f", $1 / $2 }')"
+fi
