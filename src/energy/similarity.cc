@@ -1,4 +1,4 @@
-#include "finecap/similarity.h"
+#include "finecap/energy/similarity.h"
 
 namespace finecap {
 
