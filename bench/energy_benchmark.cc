@@ -19,7 +19,7 @@
 #include "finecap/frame_reader.h"
 #include "finecap/io/capture.h"
 #include "finecap/refine.h"
-#include "finecap/sweep.h"
+#include "finecap/solvers/sweep.h"
 
 namespace finecap {
 namespace {

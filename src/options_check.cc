@@ -1,9 +1,8 @@
-// The Check() of the options structs of refinement (refine.h, solver.h, sweep.h, the colour
-// options of sequence.h) and of the held-out score (heldout_score.h), and the names of their
-// choices (enum_names.h) and of the optical flow's (optical_flow.h), which the config's eval
-// section lists:
-// pure validation, kept apart from the stages' code so that reading a config links none of the
-// stages (the config fuzzer builds from the parser sources alone).
+// The Check() of the options structs of refinement (refine.h, the colour options of sequence.h) and
+// of the held-out score (heldout_score.h), and the names of their choices (enum_names.h) and of the
+// optical flow's (optical_flow.h), which the config's eval section lists: pure validation, kept
+// apart from the stages' code so that reading a config links none of the stages (the config fuzzer
+// builds from the parser sources alone).
 //
 // Each Check() names the C++ field it refuses; its ranges are the config schema's
 // (config_options_test walks the schema and holds them to it).
@@ -13,8 +12,8 @@
 #include "finecap/optical_flow.h"
 #include "finecap/refine.h"
 #include "finecap/sequence.h"
-#include "finecap/solver.h"
-#include "finecap/sweep.h"
+#include "finecap/solvers/solver.h"
+#include "finecap/solvers/sweep.h"
 #include "finecap/util/error.h"
 #include "util/option_checks.h"
 
@@ -22,29 +21,6 @@ namespace finecap {
 
 using internal::RequireFieldRange;
 using internal::RequireKnownChoice;
-
-const std::vector<EnumName<SolverType>>& EnumNames(SolverType) {
-  static const std::vector<EnumName<SolverType>> names = {
-      {SolverType::kCeres, "ceres"},
-      {SolverType::kGradientAscent, "gradient_ascent"},
-      {SolverType::kLbfgs, "lbfgs"}};
-  return names;
-}
-
-const std::vector<EnumName<TrustRegionType>>& EnumNames(TrustRegionType) {
-  static const std::vector<EnumName<TrustRegionType>> names = {
-      {TrustRegionType::kLevenbergMarquardt, "levenberg_marquardt"},
-      {TrustRegionType::kDogleg, "dogleg"}};
-  return names;
-}
-
-const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType) {
-  static const std::vector<EnumName<LinearSolverType>> names = {
-      {LinearSolverType::kSparseNormalCholesky, "sparse_normal_cholesky"},
-      {LinearSolverType::kCgnr, "cgnr"},
-      {LinearSolverType::kDenseQr, "dense_qr"}};
-  return names;
-}
 
 const std::vector<EnumName<FlowMethod>>& EnumNames(FlowMethod) {
   static const std::vector<EnumName<FlowMethod>> names = {{FlowMethod::kDis, "dis"},
@@ -88,33 +64,6 @@ void RefineOptions::Check() const {
   solver.Check();
   sweep.Check();
   coarse_to_fine.Check();
-}
-
-void SolverOptions::Check() const {
-  RequireKnownChoice(type, "SolverOptions::type");
-  RequireFieldRange(max_iterations, 0, 100000, "SolverOptions::max_iterations");
-  RequireFieldRange(function_tolerance, 0.0, 1.0, "SolverOptions::function_tolerance");
-  Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
-  RequireKnownChoice(trust_region, "SolverOptions::trust_region");
-  RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
-  // Ceres' dogleg needs the exact Gauss-Newton step, which conjugate gradients do not give.
-  Require(type != SolverType::kCeres || trust_region != TrustRegionType::kDogleg ||
-              linear_solver != LinearSolverType::kCgnr,
-          "SolverOptions::trust_region",
-          "dogleg needs an exact linear solver (sparse_normal_cholesky or dense_qr), not cgnr");
-  RequireFieldRange(initial_step, 1e-9, 1.0, "SolverOptions::initial_step");
-  RequireFieldRange(step_growth, 1.0, 10.0, "SolverOptions::step_growth");
-  RequireFieldRange(step_shrink, 1e-3, 0.999, "SolverOptions::step_shrink");
-  RequireFieldRange(max_step, 1e-9, 1.0, "SolverOptions::max_step");
-}
-
-void SweepOptions::Check() const {
-  // Fewer than 3 displacements would not include k = 0 and both signs.
-  Require(samples == 0 || (samples >= kMinSamples && samples <= kMaxSamples),
-          "SweepOptions::samples",
-          "is " + std::to_string(samples) + " but must be 0 (off) or lie in [" +
-              std::to_string(kMinSamples) + ", " + std::to_string(kMaxSamples) + "]");
-  RequireFieldRange(smoothing_rounds, 0, 1000, "SweepOptions::smoothing_rounds");
 }
 
 void CoarseToFineOptions::Check() const {

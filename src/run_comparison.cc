@@ -5,7 +5,7 @@
 #include "finecap/frame_reader.h"
 #include "finecap/html_report.h"
 #include "finecap/run_folder.h"
-#include "finecap/solver_trace.h"
+#include "finecap/solvers/solver_trace.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 #include "finecap/util/plot.h"

@@ -9,7 +9,7 @@
 #include "finecap/ground_truth.h"
 #include "finecap/metrics.h"
 #include "finecap/scene_scale.h"
-#include "finecap/solver_trace.h"
+#include "finecap/solvers/solver_trace.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 

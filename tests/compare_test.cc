@@ -13,7 +13,7 @@
 
 #include "finecap/commands.h"
 #include "finecap/config.h"
-#include "finecap/solver_trace.h"
+#include "finecap/solvers/solver_trace.h"
 #include "finecap/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/solver.h"
+#include "finecap/solvers/solver.h"
 
 namespace finecap {
 namespace {

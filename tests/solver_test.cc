@@ -1,4 +1,4 @@
-#include "finecap/solver.h"
+#include "finecap/solvers/solver.h"
 
 #include <algorithm>
 #include <cstdlib>
@@ -8,8 +8,8 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
-#include "finecap/ceres_cost_functions.h"
 #include "finecap/util/error.h"
+#include "solvers/ceres_cost_functions.h"
 
 namespace finecap {
 namespace {

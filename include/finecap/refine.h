@@ -24,8 +24,8 @@
 #include "finecap/model/image_gaussians.h"
 #include "finecap/model/surface_gaussians.h"
 #include "finecap/model/visibility.h"
-#include "finecap/solver.h"
-#include "finecap/sweep.h"
+#include "finecap/solvers/solver.h"
+#include "finecap/solvers/sweep.h"
 #include "finecap/util/enum_names.h"
 
 namespace finecap {

@@ -1,4 +1,4 @@
-#include "finecap/ceres_cost_functions.h"
+#include "solvers/ceres_cost_functions.h"
 
 #include <algorithm>
 #include <utility>

@@ -7,7 +7,7 @@
 
 #include <ceres/ceres.h>
 
-#include "finecap/ceres_cost_functions.h"
+#include "solvers/ceres_cost_functions.h"
 #include "solvers/solvers_internal.h"
 
 namespace finecap {

@@ -1,4 +1,4 @@
-#include "finecap/solver.h"
+#include "finecap/solvers/solver.h"
 
 #include <cmath>
 #include <vector>

@@ -7,7 +7,7 @@
 
 #include <ceres/iteration_callback.h>
 
-#include "finecap/solver.h"
+#include "finecap/solvers/solver.h"
 
 namespace finecap {
 namespace internal {

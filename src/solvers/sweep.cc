@@ -1,4 +1,4 @@
-#include "finecap/sweep.h"
+#include "finecap/solvers/sweep.h"
 
 #include <vector>
 

@@ -1,4 +1,4 @@
-#include "finecap/solver_trace.h"
+#include "finecap/solvers/solver_trace.h"
 
 #include <algorithm>
 #include <sstream>

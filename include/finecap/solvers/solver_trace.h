@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "finecap/solver.h"
+#include "finecap/solvers/solver.h"
 
 namespace finecap {
 
