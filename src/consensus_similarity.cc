@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "finecap/surface_color_similarity.h"
 #include "finecap/util/error.h"
@@ -310,17 +311,24 @@ void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<doubl
     return;
   }
   RowColors row_colors(views_.size());
+  std::vector<std::pair<int, int>> rows;  // (camera, row) of every row of every camera.
   for (size_t c = 0; c < views_.size(); ++c) {
     const int num_rows = static_cast<int>(views_[c].pairs.surface_ids.size());
     row_colors[c].resize(num_rows);
-#pragma omp parallel for schedule(static)
-    for (int row = 0; row < num_rows; ++row)
-      row_colors[c][row] = Interpolate(c, row, k[0], nullptr);
+    for (int row = 0; row < num_rows; ++row) rows.emplace_back(static_cast<int>(c), row);
   }
+  const int num_rows = static_cast<int>(rows.size());
   const int num_blocks = static_cast<int>(blocks_.size());
   costs->resize(num_blocks);
+  // One parallel region for both loops: on a busy machine each region's start and barrier can
+  // wait a time slice for a thread, and the sweep calls this for every sample.
 #pragma omp parallel
   {
+#pragma omp for schedule(static)
+    for (int i = 0; i < num_rows; ++i) {
+      const auto [c, row] = rows[i];
+      row_colors[c][row] = Interpolate(c, row, k[0], nullptr);
+    }
     std::vector<double> residuals;
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
