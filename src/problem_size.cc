@@ -27,8 +27,11 @@ constexpr double kConsensusBytesPerObservation =
     400.0;                             // The 8-bit images and the buffers of one at a time.
 constexpr double kBytesPerPair = 8.0;  // The image Gaussian's id and the pair's colour weight.
 // Residual blocks, neighbourhoods, the regulariser and the solver's sparse matrices, which grow
-// with the surface Gaussians (not with the cameras that see them).
-constexpr double kBytesPerSurfaceGaussian = 3900.0;
+// with the surface Gaussians (not with the cameras that see them): with conjugate gradients
+// (Ceres' CGNR, the default), and with the sparse Cholesky factorisation, whose normal equations
+// and factor add the rest.
+constexpr double kBytesPerSurfaceGaussian = 1400.0;
+constexpr double kBytesPerSurfaceGaussianCholesky = 3900.0;
 
 // Seconds of one frame, from the same runs: the pairs dominate large problems (every evaluation
 // runs over them), the solver's linear algebra small ones. Within a factor of 3 of those runs.
@@ -75,9 +78,13 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     size.num_pixels += double(frame.cameras[c].width) * frame.cameras[c].height;
   }
 
-  double bytes = size.num_pixels * (kBytesPerPixel + kBytesPerPixelReadAhead) +
-                 size.num_pairs * kBytesPerPair +
-                 size.num_surface_gaussians * kBytesPerSurfaceGaussian;
+  double bytes =
+      size.num_pixels * (kBytesPerPixel + kBytesPerPixelReadAhead) +
+      size.num_pairs * kBytesPerPair +
+      size.num_surface_gaussians * (options.solver.type == SolverType::kCeres &&
+                                            options.solver.linear_solver != LinearSolverType::kCgnr
+                                        ? kBytesPerSurfaceGaussianCholesky
+                                        : kBytesPerSurfaceGaussian);
   if (options.energy.similarity == SimilarityType::kConsensus) {
     // Its colour tables (value and derivative, 3 floats each, per node) and the residuals and
     // Jacobians of the patches (3 channels of about 7 members, two doubles each) per

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
@@ -20,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kSubfolders[] = {"meshes", "k", "traces", "frames", "colors"};
+const char* const kSubfolders[] = {"meshes", "k", "traces", "frames"};
 
 // Holds an exclusive flock on `path` (created if missing) while it lives.
 class FileLock {
@@ -121,10 +122,12 @@ std::vector<RefinedFrame> FindRefinedFrames(const std::string& out,
   return done;
 }
 
-int PrepareRunSubfolders(const std::string& out) {
+int PrepareRunSubfolders(const std::string& out, bool followed_colors) {
   int removed = RemoveStaleTemporaries(out);
-  for (const char* name : kSubfolders) {
-    const std::string folder = out + "/" + name;
+  std::vector<std::string> folders;
+  for (const char* name : kSubfolders) folders.push_back(out + "/" + name);
+  if (followed_colors) folders.push_back(FollowedColorsFolder(out));
+  for (const std::string& folder : folders) {
     std::error_code error;
     fs::create_directories(folder, error);
     // Another shard may create it at the same moment: what matters is that it exists.

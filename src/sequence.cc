@@ -454,7 +454,7 @@ SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
   options.Check();
   SequenceObserver silent;
   if (observer == nullptr) observer = &silent;
-  const int stale = PrepareRunSubfolders(out);
+  const int stale = PrepareRunSubfolders(out, FollowsColors(options));
   if (stale > 0) observer->StaleFilesRemoved(stale);
   const StatsLog log(out, capture->frame_names(), options.mesh_format);
   log.Rebuild();

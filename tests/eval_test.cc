@@ -233,7 +233,7 @@ void WriteTruthAsRun(const std::string& capture_dir, const Config& config, const
   const Capture capture = Capture::Open(capture_dir);
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
                             capture_dir);
-  PrepareRunSubfolders(out);
+  PrepareRunSubfolders(out, false);
   for (int frame = 0; frame < capture.num_frames(); ++frame) {
     const Mesh coarse = capture.ReadCoarseMesh(frame);
     Mesh truth = model.Subdivide(coarse);

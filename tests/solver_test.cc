@@ -40,15 +40,27 @@ bool CheckGradient(const ceres::CostFunction& cost, const std::vector<double>& v
 
 class CeresCostTest : public ::testing::TestWithParam<EnergyForm> {};
 
+// The scene the cost-function tests share: three cameras up to 75 degrees, and a k that varies
+// from Gaussian to Gaussian.
+struct CostScene {
+  CostScene(const std::string& similarity, const std::string& overlap)
+      : scene(MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31)),
+        energy(scene.surface, scene.cameras, scene.neighbourhoods, Options(similarity, overlap)),
+        k(energy.num_parameters()) {
+    for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  }
+  EnergyScene scene;
+  FrameEnergy energy;
+  Eigen::VectorXd k;
+};
+
 // Every kind of least-squares residual, checked by ceres::GradientChecker against numeric
 // differences, including cameras at 75 degrees (near grazing).
 TEST_P(CeresCostTest, SimilarityBlocksPassTheGradientChecker) {
   const auto [similarity, overlap] = GetParam();
-  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
-  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
-                     Options(similarity, overlap));
-  Eigen::VectorXd k(energy.num_parameters());
-  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  CostScene scene(similarity, overlap);
+  FrameEnergy& energy = scene.energy;
+  const Eigen::VectorXd& k = scene.k;
   SimilarityTerm& term = energy.similarity();
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
   int checked = 0, failed = 0;
@@ -148,11 +160,9 @@ TEST(CeresCostTest, TheCallbackPreparesEachPointOnce) {
 // surface_color) and of several (the paper's), with at most one residual more than parameters.
 TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
   const auto [similarity, overlap] = GetParam();
-  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
-  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
-                     Options(similarity, overlap));
-  Eigen::VectorXd k(energy.num_parameters());
-  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  CostScene scene(similarity, overlap);
+  FrameEnergy& energy = scene.energy;
+  const Eigen::VectorXd& k = scene.k;
   SimilarityTerm& term = energy.similarity();
   term.PrepareResiduals(k, true);
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
@@ -197,11 +207,9 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
 // squares of its residuals, which lets the solvers take E from the least-squares cost.
 TEST_P(CeresCostTest, LeastSquaresTermsAgreeWithTheirResiduals) {
   const auto [similarity, overlap] = GetParam();
-  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
-  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
-                     Options(similarity, overlap));
-  Eigen::VectorXd k(energy.num_parameters());
-  for (int s = 0; s < k.size(); ++s) k[s] = 0.002 * std::sin(1.7 * s);
+  CostScene scene(similarity, overlap);
+  FrameEnergy& energy = scene.energy;
+  const Eigen::VectorXd& k = scene.k;
   SimilarityTerm& term = energy.similarity();
   EXPECT_EQ(term.IsLeastSquares(), similarity != "paper");
   if (!term.IsLeastSquares()) return;

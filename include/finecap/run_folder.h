@@ -82,9 +82,10 @@ std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,
                                              const std::vector<std::string>& frame_names, int frame,
                                              MeshFormat mesh_format);
 
-// Creates the subfolders of a run folder and removes the temporaries that killed runs left in
-// it (RemoveStaleTemporaries); returns how many were removed.
-int PrepareRunSubfolders(const std::string& out);
+// Creates the subfolders of a run folder (colors/ only for a run whose colours follow the
+// sequence) and removes the temporaries that killed runs left in it (RemoveStaleTemporaries);
+// returns how many were removed.
+int PrepareRunSubfolders(const std::string& out, bool followed_colors);
 
 // stats.jsonl of a run folder. Appending and rebuilding hold an advisory lock (flock on
 // out/.stats.lock), so shards sharing the folder never interleave their writes; a record is
