@@ -315,7 +315,7 @@ class SequenceRun {
     AddGroundTruthErrors(*capture_, model_, input.coarse, frame, regions_, result, &stats);
     // Before the record, which marks the frame done: a done frame always has them.
     if (FollowsColors(options_) && frame >= options_.reference_frame) {
-      SaveFollowedColors(name, colors, input, result, stats.worse || result.worse);
+      SaveFollowedColors(name, colors, input, result, stats.worse);
     }
     WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
                start, log_);

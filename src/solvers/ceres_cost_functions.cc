@@ -53,7 +53,7 @@ bool SimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* 
 }
 
 ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& term, int block)
-    : term_(term), block_(block) {
+    : term_(term), block_(block), full_(term, block) {
   const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
   num_full_residuals_ = info.num_residuals;
   const int num_parameters = static_cast<int>(info.parameters.size());
@@ -61,23 +61,14 @@ ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& ter
   mutable_parameter_block_sizes()->assign(num_parameters, 1);
 }
 
-bool ReducedSimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* residuals,
+bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, double* residuals,
                                           double** jacobians) const {
   const int m = num_full_residuals_;
   const int p = static_cast<int>(parameter_block_sizes().size());
   thread_local Eigen::VectorXd r;
   thread_local Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian;
   r.resize(m);
-  if (m == num_residuals()) {  // Nothing to reduce: the block as it is.
-    jacobian.resize(m, p);
-    term_.BlockResiduals(block_, residuals, jacobians != nullptr ? jacobian.data() : nullptr);
-    if (jacobians == nullptr) return true;
-    for (int q = 0; q < p; ++q) {
-      if (jacobians[q] == nullptr) continue;
-      for (int i = 0; i < m; ++i) jacobians[q][i] = jacobian(i, q);
-    }
-    return true;
-  }
+  if (m == num_residuals()) return full_.Evaluate(parameters, residuals, jacobians);
   std::fill_n(residuals, num_residuals(), 0.0);
   if (jacobians == nullptr) {
     term_.BlockResiduals(block_, r.data(), nullptr);

@@ -65,6 +65,7 @@ class ReducedSimilarityBlockCost : public ceres::CostFunction {
   const SimilarityTerm& term_;
   int block_;
   int num_full_residuals_;
+  SimilarityBlockCost full_;  // The block as it is, for a block with nothing to reduce.
 };
 
 // The same residual block, but preparing the term itself at the parameters it is given (the
