@@ -15,10 +15,10 @@
 
 #include <benchmark/benchmark.h>
 
-#include "finecap/config.h"
-#include "finecap/frame_reader.h"
+#include "finecap/config/config.h"
 #include "finecap/io/capture.h"
-#include "finecap/refine.h"
+#include "finecap/refine/frame_reader.h"
+#include "finecap/refine/refine.h"
 #include "finecap/solvers/sweep.h"
 
 namespace finecap {

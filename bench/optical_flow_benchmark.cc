@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/optical_flow.h"
+#include "finecap/eval/optical_flow.h"
 
 namespace finecap {
 namespace {

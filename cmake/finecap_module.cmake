@@ -79,18 +79,25 @@ function(finecap_linked_modules target out)
   set(${out} ${linked} PARENT_SCOPE)
 endfunction()
 
-# Writes `file` with one line per module, "<module> -> <modules it links>", top-down, and one for
-# each of the further library targets given (which are not modules yet but link them).
+# The libraries of every module, top-down, in `libraries`, and their internal targets in
+# `internals` (what the tests link).
+function(finecap_module_targets libraries internals)
+  get_property(modules GLOBAL PROPERTY FINECAP_MODULES)
+  list(REVERSE modules)
+  set(public "")
+  set(internal "")
+  foreach(module ${modules})
+    list(APPEND public finecap_${module})
+    list(APPEND internal finecap_${module}_internal)
+  endforeach()
+  set(${libraries} ${public} PARENT_SCOPE)
+  set(${internals} ${internal} PARENT_SCOPE)
+endfunction()
+
+# Writes `file` with one line per module, "<module> -> <modules it links>", top-down.
 function(finecap_write_module_graph file)
   get_property(modules GLOBAL PROPERTY FINECAP_MODULES)
   set(lines "")
-  foreach(target ${ARGN})
-    string(REGEX REPLACE "^finecap_" "" node ${target})
-    finecap_linked_modules(${target} linked)
-    string(REPLACE ";" " " linked "${linked}")
-    string(STRIP "${node} -> ${linked}" line)
-    string(APPEND lines "${line}\n")
-  endforeach()
   list(REVERSE modules)
   foreach(module ${modules})
     finecap_linked_modules(finecap_${module} linked ${module})

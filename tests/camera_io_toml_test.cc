@@ -10,7 +10,7 @@
 
 #include "finecap/io/camera_io.h"
 #include "finecap/io/capture.h"
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 #include "tiny_synth.h"

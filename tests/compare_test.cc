@@ -1,7 +1,7 @@
 // finecap compare: the compare section of a config (variants checked against the schema), the
 // summary of a variant's records against hand computations, solver traces as CSV, and the whole
 // command on a tiny synthetic capture, plus its bad input.
-#include "finecap/comparison.h"
+#include "finecap/eval/comparison.h"
 
 #include <cmath>
 #include <filesystem>
@@ -11,10 +11,10 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
 #include "finecap/solvers/solver_trace.h"
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

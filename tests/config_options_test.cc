@@ -12,7 +12,7 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 

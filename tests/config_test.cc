@@ -1,4 +1,4 @@
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 
 #include <filesystem>
 #include <fstream>

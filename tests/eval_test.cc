@@ -1,9 +1,9 @@
 // finecap eval: the figures of the evaluation against independent computations, and the whole
 // command on a tiny refined synthetic run (metrics.json, pictures, report), plus its bad input.
-#include "finecap/evaluation.h"
+#include "eval/mesh_viewer.h"
+#include "finecap/eval/evaluation.h"
 #include "finecap/io/export.h"
 #include "finecap/io/mesh_io.h"
-#include "finecap/mesh_viewer.h"
 
 #include <cmath>
 #include <filesystem>
@@ -14,11 +14,11 @@
 #include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/run_folder.h"
-#include "finecap/sequence.h"
-#include "finecap/synth.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
+#include "finecap/refine/run_folder.h"
+#include "finecap/refine/sequence.h"
+#include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

@@ -1,4 +1,4 @@
-#include "finecap/frame_stats.h"
+#include "finecap/refine/frame_stats.h"
 
 #include <cmath>
 

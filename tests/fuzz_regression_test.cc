@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 #include "finecap/io/camera_io.h"
 #include "test_util.h"
 

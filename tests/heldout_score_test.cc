@@ -1,6 +1,6 @@
 // The held-out score (heldout_score.h) on synthetic views, and held-out cameras in finecap refine
 // and eval: never used by the refinement, scored in the stats and metrics, bad names refused.
-#include "finecap/heldout_score.h"
+#include "finecap/measure/heldout_score.h"
 
 #include <cmath>
 #include <filesystem>
@@ -10,10 +10,10 @@
 #include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/frame_stats.h"
-#include "finecap/synth.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
+#include "finecap/refine/frame_stats.h"
+#include "finecap/synth/synth.h"
 #include "finecap/util/error.h"
 #include "finecap/util/threads.h"
 #include "test_util.h"

@@ -9,10 +9,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/frame_stats.h"
-#include "finecap/synth.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
+#include "finecap/refine/frame_stats.h"
+#include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

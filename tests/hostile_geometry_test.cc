@@ -6,16 +6,16 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/commands.h"
-#include "finecap/frame_reader.h"
-#include "finecap/frame_stats.h"
+#include "finecap/commands/commands.h"
 #include "finecap/geometry/mesh_diagnostics.h"
 #include "finecap/io/camera_io.h"
 #include "finecap/io/capture.h"
 #include "finecap/io/mesh_io.h"
-#include "finecap/refine.h"
-#include "finecap/scene_scale.h"
-#include "finecap/synth.h"
+#include "finecap/refine/frame_reader.h"
+#include "finecap/refine/frame_stats.h"
+#include "finecap/refine/refine.h"
+#include "finecap/synth/synth.h"
+#include "refine/scene_scale.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

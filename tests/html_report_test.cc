@@ -1,4 +1,4 @@
-#include "finecap/html_report.h"
+#include "finecap/eval/html_report.h"
 
 #include <fstream>
 #include <iterator>

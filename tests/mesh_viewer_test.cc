@@ -1,4 +1,4 @@
-#include "finecap/mesh_viewer.h"
+#include "eval/mesh_viewer.h"
 
 #include <cstdint>
 #include <cstdlib>
@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/html_report.h"
+#include "finecap/eval/html_report.h"
 #include "test_meshes.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-#include "finecap/metrics.h"
+#include "finecap/measure/metrics.h"
 
 #include <cmath>
 #include <limits>

@@ -1,7 +1,7 @@
 // Optical flow and the flow evaluation against answers known by construction: an image and its
 // copy shifted by a known number of pixels, and a textured plane moved sideways by a known
 // distance in front of a pinhole camera.
-#include "finecap/optical_flow.h"
+#include "finecap/eval/optical_flow.h"
 
 #include <cmath>
 #include <string>
@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "finecap/flow_evaluation.h"
+#include "finecap/eval/flow_evaluation.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 

@@ -1,6 +1,6 @@
 // What a frame's refinement will take, known before the work: the pair count is that of the
 // pair lists the energy builds, and the forecast follows the problem's size.
-#include "finecap/problem_size.h"
+#include "finecap/refine/problem_size.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include "finecap/energy/frame_energy.h"
 #include "finecap/io/capture.h"
 #include "finecap/model/gaussian_pairs.h"
-#include "finecap/scene_scale.h"
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
+#include "refine/scene_scale.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

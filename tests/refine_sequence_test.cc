@@ -1,7 +1,7 @@
 // A sequence refined frame after frame (sequence.h): how one frame's result seeds the next (warm
 // start) when bias compensation and kept inputs are involved, the reference colours' recipe, what
 // the observer hears.
-#include "finecap/sequence.h"
+#include "finecap/refine/sequence.h"
 
 #include <cmath>
 #include <filesystem>
@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/frame_stats.h"
-#include "finecap/synth.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
+#include "finecap/refine/frame_stats.h"
+#include "finecap/synth/synth.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
 #include "test_util.h"

@@ -1,9 +1,9 @@
-#include "finecap/refine.h"
+#include "finecap/refine/refine.h"
 
 #include <gtest/gtest.h>
 
-#include "finecap/frame_reader.h"
 #include "finecap/io/capture.h"
+#include "finecap/refine/frame_reader.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

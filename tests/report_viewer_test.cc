@@ -9,10 +9,10 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/mesh_viewer.h"
-#include "finecap/synth.h"
+#include "eval/mesh_viewer.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
+#include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

@@ -18,10 +18,10 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
 #include "finecap/io/mesh_io.h"
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
 

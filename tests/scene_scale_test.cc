@@ -1,6 +1,6 @@
 // The lengths that follow from the scene: what MeasureSceneScale measures, and that
 // ResolveSceneScaleDefaults scales with the scene and leaves set lengths alone.
-#include "finecap/scene_scale.h"
+#include "refine/scene_scale.h"
 
 #include <cmath>
 #include <filesystem>

@@ -9,9 +9,9 @@
 
 #include <gtest/gtest.h>
 
-#include "finecap/config.h"
-#include "finecap/sequence.h"
-#include "finecap/synth.h"
+#include "finecap/config/config.h"
+#include "finecap/refine/sequence.h"
+#include "finecap/synth/synth.h"
 #include "finecap/util/error.h"
 #include "test_util.h"
 #include "tiny_synth.h"

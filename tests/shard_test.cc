@@ -1,10 +1,10 @@
 // Sharding a frame range: contiguous near-equal parts that cover it exactly once, and "I/N" text
 // validated with errors that name where it came from.
-#include "finecap/shard.h"
+#include "finecap/refine/shard.h"
 
 #include <gtest/gtest.h>
 
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 #include "test_util.h"
 
 namespace finecap {

@@ -10,7 +10,7 @@
 
 #include "energy_fixture.h"
 #include "finecap/geometry/render.h"
-#include "finecap/refine.h"
+#include "finecap/refine/refine.h"
 
 namespace finecap {
 namespace {

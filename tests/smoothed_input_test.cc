@@ -12,10 +12,10 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/Dense>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
 #include "finecap/io/mesh_io.h"
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
 #include "test_meshes.h"
 #include "test_util.h"
 #include "tiny_synth.h"

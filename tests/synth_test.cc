@@ -1,4 +1,4 @@
-#include "finecap/synth.h"
+#include "finecap/synth/synth.h"
 
 #include <cmath>
 #include <filesystem>

@@ -11,10 +11,10 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
-#include "finecap/frame_stats.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
 #include "finecap/io/capture.h"
+#include "finecap/refine/frame_stats.h"
 #include "test_util.h"
 
 namespace finecap {

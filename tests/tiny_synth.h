@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "finecap/config.h"
-#include "finecap/synth.h"
+#include "finecap/config/config.h"
+#include "finecap/synth/synth.h"
 
 namespace finecap {
 namespace testing_util {

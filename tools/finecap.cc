@@ -13,8 +13,8 @@
 #include <gflags/gflags.h>
 #include <glog/logging.h>
 
-#include "finecap/commands.h"
-#include "finecap/config.h"
+#include "finecap/commands/commands.h"
+#include "finecap/config/config.h"
 #include "finecap/util/error.h"
 #include "finecap/util/threads.h"
 

@@ -7,13 +7,13 @@
 #include <string>
 #include <vector>
 
-#include "finecap/config.h"
-#include "finecap/heldout_score.h"
+#include "finecap/config/config.h"
 #include "finecap/io/capture.h"
-#include "finecap/refine.h"
-#include "finecap/run_folder.h"
-#include "finecap/scene_scale.h"
-#include "finecap/sequence.h"
+#include "finecap/measure/heldout_score.h"
+#include "finecap/refine/refine.h"
+#include "finecap/refine/run_folder.h"
+#include "finecap/refine/sequence.h"
+#include "refine/scene_scale.h"
 
 namespace finecap {
 namespace internal {

@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
-#include "finecap/run_comparison.h"
+#include "finecap/commands/commands.h"
+#include "finecap/eval/run_comparison.h"
 #include "finecap/util/error.h"
 #include "finecap/util/threads.h"
 

@@ -6,8 +6,8 @@
 #include <optional>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
-#include "finecap/run_evaluation.h"
+#include "finecap/commands/commands.h"
+#include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

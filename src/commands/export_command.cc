@@ -5,7 +5,7 @@
 #include <iostream>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
+#include "finecap/commands/commands.h"
 #include "finecap/io/export.h"
 #include "finecap/io/mesh_io.h"
 

@@ -4,10 +4,10 @@
 #include <iostream>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
-#include "finecap/problem_size.h"
-#include "finecap/scene_scale.h"
-#include "finecap/shard.h"
+#include "finecap/commands/commands.h"
+#include "finecap/refine/problem_size.h"
+#include "finecap/refine/shard.h"
+#include "refine/scene_scale.h"
 
 namespace finecap {
 namespace {

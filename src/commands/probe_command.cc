@@ -10,7 +10,7 @@
 #include <iostream>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
+#include "finecap/commands/commands.h"
 #include "finecap/util/error.h"
 #include "finecap/util/plot.h"
 

@@ -1,7 +1,7 @@
 // finecap refine: every configured frame of a capture (of this shard), refined into output.dir.
 #include "commands/command_util.h"
-#include "finecap/commands.h"
-#include "finecap/shard.h"
+#include "finecap/commands/commands.h"
+#include "finecap/refine/shard.h"
 
 namespace finecap {
 

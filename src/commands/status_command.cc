@@ -4,9 +4,9 @@
 #include <vector>
 
 #include "commands/command_util.h"
-#include "finecap/commands.h"
-#include "finecap/run_folder.h"
-#include "finecap/shard.h"
+#include "finecap/commands/commands.h"
+#include "finecap/refine/run_folder.h"
+#include "finecap/refine/shard.h"
 
 namespace finecap {
 namespace {

@@ -1,8 +1,8 @@
 // finecap synth: a synthetic capture with ground truth, written to output.dir.
 #include <iostream>
 
-#include "finecap/commands.h"
-#include "finecap/synth.h"
+#include "finecap/commands/commands.h"
+#include "finecap/synth/synth.h"
 #include "finecap/util/error.h"
 
 namespace finecap {

@@ -1,5 +1,5 @@
 // A config file: LoadConfig on arbitrary bytes, no overrides.
-#include "finecap/config.h"
+#include "finecap/config/config.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,6 +1,6 @@
 // A stats record (a line of stats.jsonl): ParseFrameStats on arbitrary bytes; a record that reads
 // must read again, unchanged, once written by ToJson.
-#include "finecap/frame_stats.h"
+#include "finecap/refine/frame_stats.h"
 #include "fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,0 +1,76 @@
+// The figures `finecap eval` computes for one refined frame against the ground truth, and the
+// false-colour scale of its error pictures.
+//
+// Conventions: displacements k are metres along the unit normals of the subdivided input mesh
+// (the refinement's own parameters); the input mesh itself is k = 0. Errors are taken over the
+// refined vertices where both the estimate and the truth are known. The true normal of a vertex
+// is the normal of the input mesh displaced by the true k (NaN counted as 0): the true surface
+// sampled at the vertex's own line, so no ray-cast triangle lookup is needed and both normals
+// come from the same topology.
+#ifndef FINECAP_EVAL_EVALUATION_H_
+#define FINECAP_EVAL_EVALUATION_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "finecap/geometry/mesh.h"
+#include "finecap/measure/metrics.h"
+
+namespace finecap {
+
+// What one frame (or a whole sequence, pooled) is evaluated on. All vectors and matrices have one
+// entry or column per vertex of the subdivided input mesh.
+struct EvaluationSamples {
+  Eigen::VectorXd k_refined;         // Refined displacement, metres; NaN where not refined.
+  Eigen::VectorXd k_true;            // True displacement, metres; NaN where unknown.
+  Eigen::Matrix3Xd normals_input;    // Unit normals of the subdivided input mesh.
+  Eigen::Matrix3Xd normals_refined;  // Unit normals of the refined mesh.
+  Eigen::Matrix3Xd normals_true;     // Unit normals of the input mesh displaced by k_true.
+  std::vector<int> all;              // Refined vertex ids: the region every figure is taken over.
+  std::vector<int> textured;         // The part of `all` outside the textureless region.
+  std::vector<int> textureless;      // The part of `all` inside it.
+
+  // Appends `other`, offsetting its vertex ids: pooled samples give sequence-wide figures.
+  void Append(const EvaluationSamples& other);
+};
+
+// The figures of one region: displacement errors of the input (k = 0) and of the refinement, in
+// metres (ErrorStats), and mean normal angle errors in degrees.
+struct RegionFigures {
+  ErrorStats coarse;
+  ErrorStats refined;
+  double normal_error_coarse_deg = ErrorStats::kNoData;
+  double normal_error_refined_deg = ErrorStats::kNoData;
+  // DetailRecovered(refined.rms, coarse.rms): 1 perfect, 0 no gain, < 0 worse.
+  double detail_recovered = ErrorStats::kNoData;
+};
+
+// Figures over all refined vertices and over their textured and textureless parts.
+struct EvaluationFigures {
+  RegionFigures all, textured, textureless;
+};
+
+// Builds the samples of one frame. `input` is the subdivided input mesh, `refined` the refined
+// mesh (same topology), `k_refined` and `k_true` as in EvaluationSamples, `refined_vertices` the
+// refined vertex ids and `textureless_vertices` the fine ids of the textureless region. Throws
+// Error naming `where` when sizes or topologies disagree or an id is out of range.
+EvaluationSamples MakeEvaluationSamples(const Mesh& input, const Mesh& refined,
+                                        const Eigen::VectorXd& k_refined,
+                                        const Eigen::VectorXd& k_true,
+                                        const std::vector<int>& refined_vertices,
+                                        const std::vector<int>& textureless_vertices,
+                                        const std::string& where);
+
+// The figures of `samples`. The input's error is measured over the same vertices as the
+// refinement's: those with a finite refined k.
+EvaluationFigures ComputeEvaluationFigures(const EvaluationSamples& samples);
+
+// A false-colour RGB in [0, 1] per entry of `values` (OpenCV's "turbo" map, blue = 0, dark red
+// = `max_value` and above); mid grey for a non-finite value. Throws Error unless max_value > 0.
+Eigen::Matrix3Xd HeatMapColors(const Eigen::VectorXd& values, double max_value);
+
+}  // namespace finecap
+
+#endif  // FINECAP_EVAL_EVALUATION_H_

@@ -1,0 +1,83 @@
+// The statistics record of one refined frame: one JSON object per frame, one line each in the
+// output folder's stats.jsonl.
+#ifndef FINECAP_REFINE_FRAME_STATS_H_
+#define FINECAP_REFINE_FRAME_STATS_H_
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "finecap/refine/refine.h"
+
+namespace finecap {
+
+struct FrameStats {
+  std::string frame;       // The frame's name.
+  std::string solver;      // solver.type.
+  std::string similarity;  // energy.similarity.
+  double energy_start = 0.0;
+  double energy_end = 0.0;
+  double ls_cost_start = 0.0;
+  double ls_cost_end = 0.0;
+  int iterations = 0;
+  int evaluations = 0;
+  std::string termination;
+  double seconds = 0.0;              // The whole frame, reading and writing included.
+  double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pairs.
+  double seconds_solve = 0.0;
+  double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
+  double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.
+  double seconds_heldout = 0.0;        // After the solve: the held-out score (validation.cameras).
+  int surface_gaussians = 0;
+  long image_gaussians = 0;
+  long pairs = 0;
+  bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.
+  bool kept_input = false;  // And the input surface was written instead.
+  // Against ground truth, when the capture has it (NaN otherwise): RMS of k - k_true over the
+  // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
+  double rms_coarse_mm = 0.0;
+  double rms_refined_mm = 0.0;
+  // The same over the textureless region (NaN when the capture marks none).
+  double rms_textureless_coarse_mm = 0.0;
+  double rms_textureless_refined_mm = 0.0;
+  // In the held-out cameras (validation.cameras; heldout_score.h), NaN when there are none: the
+  // mean local NCC and mean absolute grey-level difference between each held-out image and the
+  // training views warped into it through the subdivided input mesh and through the refined
+  // mesh as solved (before refine.keep_input_if_worse puts the input back). A refined NCC below
+  // the input's flags the frame `worse`.
+  double heldout_ncc_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_ncc_refined = std::numeric_limits<double>::quiet_NaN();
+  double heldout_mad_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_mad_refined = std::numeric_limits<double>::quiet_NaN();
+  // Cameras left out of this frame because their image could not be read
+  // (capture.skip_unreadable_cameras); empty when every camera was used.
+  std::vector<std::string> skipped_cameras;
+  // The process's peak resident memory when the frame was done (getrusage's ru_maxrss), MB of
+  // 2^20 bytes. Over a long run it should stay flat: nothing grows with the frames.
+  double peak_rss_mb = 0.0;
+};
+
+// The peak resident memory of this process so far, MB of 2^20 bytes (getrusage's ru_maxrss).
+double PeakResidentMegabytes();
+
+FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
+                          const FrameResult& result);
+
+// One line of JSON (no newline). Non-finite numbers are written as null.
+std::string ToJson(const FrameStats& stats);
+
+// The inverse of ToJson: one stats record (a line of stats.jsonl, with or without its newline).
+// null reads as NaN for the real-valued fields. A key that ToJson does not write, a value of the
+// wrong type, an integer out of range or malformed JSON throws Error(where, ...) naming the key or
+// the character; a missing key keeps its default (records of older versions lack newer keys),
+// except "frame", which is required. Numbers come back as ToJson rounded them (10 digits).
+FrameStats ParseFrameStats(const std::string& line, const std::string& where);
+
+// Reads one frame's statistics record as a run folder holds it (frames/<frame>.json; null
+// numbers read as NaN). Throws Error naming the file when it is missing, malformed or lacks a
+// field.
+FrameStats ReadFrameStats(const std::string& path);
+
+}  // namespace finecap
+
+#endif  // FINECAP_REFINE_FRAME_STATS_H_

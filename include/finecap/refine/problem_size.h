@@ -1,0 +1,57 @@
+// What refining one frame will take, known before the work: how many vertices get a surface
+// Gaussian, what each camera sees, how many pairs of Gaussians the energy will evaluate, and a
+// forecast of the peak memory and of the time of the frame.
+//
+// The pair lists dominate both for any but the smallest problems (8 bytes per pair, tens of
+// millions of pairs when the Gaussians are large against the image), and their length depends on
+// sigma_hat, k_max and the texture, so the forecast counts them: it builds the frame's image
+// Gaussians and the pairs of a sample of the surface Gaussians (every n-th, enough for a count
+// within a few per cent), without keeping them. The bytes per item (problem_size.cc) were fitted
+// to the peak RSS of refinements of synth_skirt, synth_demo and the Middlebury temple, measured
+// with bench/memory_forecast.sh on 2 cores; a machine with many more cores keeps more per-thread
+// memory (stacks, allocator arenas). The forecast is that of the configured level: the coarser
+// levels of a coarse-to-fine schedule are solved before it and freed, and measured no higher
+// (synth_skirt and the temple with refine.coarse_to_fine.levels 2: 3 % and 2 % above the
+// forecast), but they add their time, which the time forecast leaves out.
+#ifndef FINECAP_REFINE_PROBLEM_SIZE_H_
+#define FINECAP_REFINE_PROBLEM_SIZE_H_
+
+#include <vector>
+
+#include "finecap/refine/refine.h"
+
+namespace finecap {
+
+struct ProblemSize {
+  int num_fine_vertices = 0;     // After subdivision.
+  int num_refined_vertices = 0;  // Of those, the ones to refine (the vertex mask's, or all).
+  // Refined vertices that get a surface Gaussian: some camera sees them (within the view-angle
+  // cap and not occluded) and they have a reference colour.
+  int num_surface_gaussians = 0;
+  // Refined vertices that no camera sees within visibility.max_view_angle_deg: they keep the
+  // input surface.
+  int num_unseen_refined_vertices = 0;
+  // Per camera, the fine vertices it sees (refined or not): 0 marks a camera that sees nothing.
+  std::vector<int> visible_per_camera;
+  long num_image_gaussians = 0;  // Over every camera.
+  double num_pairs = 0.0;        // Estimated (a sample of the surface Gaussians, scaled).
+  double num_pixels = 0.0;       // Over every camera.
+  // Surface Gaussian and camera pairs that see each other: the residual blocks of the solve.
+  long num_observations = 0;
+
+  // Forecast peak resident memory of a run refining frames like this one, MB.
+  double peak_memory_mb = 0.0;
+  // Forecast time of one frame, seconds, on the machine the constants were measured on (2 cores);
+  // a rough figure, good to a factor of about 3.
+  double seconds_per_frame = 0.0;
+};
+
+// The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
+// `options` (whose lengths should be resolved: scene_scale.h). Builds the frame's image Gaussians
+// and visibility, so it costs a few seconds on a large rig, and keeps none of it.
+ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
+                                const FrameInput& frame, const RefineOptions& options);
+
+}  // namespace finecap
+
+#endif  // FINECAP_REFINE_PROBLEM_SIZE_H_

@@ -1,0 +1,230 @@
+// Per-frame refinement, the product's main job, independent of files and flags: subdivide the
+// coarse mesh, find what each camera sees, build the image Gaussians, set up the energy, solve
+// for the displacement k of every refined vertex along its normal, and apply it.
+//
+// Data flows one way: the caller reads a frame (coarse mesh, images) and writes the result.
+// What stays fixed over a sequence (topology, subdivision stencil, neighbourhoods, the refined
+// vertices, the reference colours) lives in SequenceModel and is computed once.
+#ifndef FINECAP_REFINE_REFINE_H_
+#define FINECAP_REFINE_REFINE_H_
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "finecap/energy/energy_options.h"
+#include "finecap/energy/frame_energy.h"
+#include "finecap/geometry/camera.h"
+#include "finecap/geometry/mesh.h"
+#include "finecap/geometry/neighbourhood.h"
+#include "finecap/geometry/subdivision.h"
+#include "finecap/model/image_gaussians.h"
+#include "finecap/model/surface_gaussians.h"
+#include "finecap/model/visibility.h"
+#include "finecap/solvers/solver.h"
+#include "finecap/solvers/sweep.h"
+#include "finecap/util/enum_names.h"
+
+namespace finecap {
+
+inline ImageGaussianOptions RefinementImageOptions() {
+  ImageGaussianOptions options;
+  options.min_leaf_size = 2;
+  options.color_space = ColorSpace::kNormalizedRgb;
+  return options;
+}
+
+// A coarse-to-fine schedule within each frame: the energy is solved first with wider surface
+// Gaussians and a coarser image model (sigma_hat and the smallest quad-tree leaf multiplied by
+// scale^level), each level starting where the coarser one ended. A wider Gaussian reaches a fold
+// further from the input surface before the fine level sharpens it; the paper names such local
+// maxima as its main limitation. The reference colours are the configured level's throughout.
+struct CoarseToFineOptions {
+  // Levels, the configured one included; 1 turns the schedule off. Default 1.
+  int levels = 1;
+  // Factor from one level to the next coarser one. Default 2.
+  double scale = 2.0;
+
+  void Check() const;
+};
+
+// Which lengths of RefineOptions follow from the scene's scale (scene_scale.h) instead of the
+// values their fields hold. Until ResolveSceneScaleDefaults replaces it, a marked field holds the
+// person-sized value finecap used before it measured the scene, and that is what RefineFrame
+// uses; a caller who sets such a length clears its mark. Default: every length follows the scene.
+struct SceneLengths {
+  bool sigma_hat = true;        // RefineOptions::sigma_hat (model.sigma_hat).
+  bool k_max = true;            // energy.k_max.
+  bool depth_tolerance = true;  // visibility.depth_tolerance.
+  bool initial_step = true;     // solver.initial_step.
+  bool max_step = true;         // solver.max_step.
+};
+
+struct RefineOptions {
+  // Loop subdivision levels applied to the coarse mesh before refinement (the paper subdivided
+  // its 1.5k-2.5k-vertex meshes to 6k-10k vertices: 1 level). Default 1.
+  int subdivision_levels = 1;
+  // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007. Follows from
+  // the scene unless set (scene_lengths).
+  double sigma_hat = 0.007;
+  // How the reference frame colours the surface Gaussians: kPixels (the paper: the mean of the
+  // pixels under the projected Gaussian in the best-aligned camera) or kImageModel (in that
+  // camera, what the energy's image model shows there; see ComputeModelReferenceColors).
+  // Default kImageModel (the paper: kPixels).
+  ReferenceColorSource reference_colors = ReferenceColorSource::kImageModel;
+  // After solving, add sigma_hat along the normal to every refined vertex, compensating the
+  // slight shrink the Gaussians' extent causes (the paper's section 6). Default false: the
+  // surface-colour similarity has no such shrink (configs/paper.yaml turns it on).
+  bool bias_compensation = false;
+  // When the solver ends with a lower energy than it started from (the run's own measure says
+  // the frame got worse), write the input surface for that frame instead; `finecap refine` does
+  // the same when the held-out NCC (validation.cameras) of the result is below the input's. The
+  // stats record flags such frames either way. Default false.
+  bool keep_input_if_worse = false;
+  // Start each frame from the previous frame's k instead of from zero. Default false.
+  bool warm_start = false;
+
+  // A plane-sweep search for each Gaussian's starting displacement (sweep.h).
+  SweepOptions sweep;
+  CoarseToFineOptions coarse_to_fine;
+
+  // The image model. Defaults differ from ImageGaussianOptions' (the paper's) in two measured
+  // ways: leaves down to 2 px (sigma 1 px) keep the texture detail the similarity needs, and
+  // colours are normalized RGB, which keeps brightness: within one frame a matte surface's
+  // shading is the same in every camera, so the consensus similarity may compare it, and a grey
+  // object has texture only there (surface_color, which compares one frame with another, used
+  // chromaticity; configs/surface_color.yaml).
+  ImageGaussianOptions image = RefinementImageOptions();
+  VisibilityOptions visibility;
+  EnergyOptions energy;
+  SolverOptions solver;
+  // The lengths above that are still to follow from the scene.
+  SceneLengths scene_lengths;
+
+  void Check() const;
+};
+
+// One frame's input: the coarse mesh and, per camera, the pinhole camera and its undistorted
+// 8-bit BGR image.
+struct FrameInput {
+  Mesh coarse;
+  std::vector<Camera> cameras;
+  std::vector<cv::Mat> images;
+};
+
+// The parts of the model that stay fixed over a sequence.
+class SequenceModel {
+ public:
+  // `first_coarse` fixes the topology; `coarse_mask` lists the coarse vertex ids to refine
+  // (empty: all). Throws Error naming `where` when the mesh cannot be subdivided.
+  SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
+                const RefineOptions& options, const std::string& where);
+
+  // The subdivided mesh of a frame and its area-weighted unit normals.
+  Mesh Subdivide(const Mesh& coarse) const;
+  int num_fine_vertices() const { return stencil_.num_fine_vertices(); }
+  // Fine vertex ids to refine: the subdivided mask (all when there is none). Those that no camera
+  // saw in the reference frame get no surface Gaussian.
+  const std::vector<int>& refined_vertices() const { return refined_vertices_; }
+  const VertexNeighbourhoods& neighbourhoods() const { return neighbourhoods_; }
+  // The fine vertices that subdivision makes from coarse vertices `coarse_ids` (an edge vertex
+  // belongs when both its ends do). Empty in, empty out.
+  std::vector<int> SubdivideIds(const std::vector<int>& coarse_ids) const;
+
+ private:
+  SubdivisionStencil stencil_;
+  int num_coarse_vertices_ = 0;
+  std::vector<int> refined_vertices_;
+  VertexNeighbourhoods neighbourhoods_;
+};
+
+// For each camera, which fine vertices of `mesh` (with `normals`) it sees.
+std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
+                                                               const Eigen::Matrix3Xd& normals,
+                                                               const std::vector<Camera>& cameras,
+                                                               const VisibilityOptions& options);
+
+// The colours of the fine vertices, from the reference frame's images at its coarse surface.
+ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
+                                      const RefineOptions& options);
+
+// The colours of the vertices of `fine` (a frame's fine mesh, e.g. its refined surface), from
+// that frame's images, as ComputeSequenceColors takes them: visibility, camera and method by
+// `options`.
+ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
+                                     const RefineOptions& options);
+
+// A frame made ready to solve: its fine mesh, the image Gaussians and the energy over them.
+struct PreparedFrame {
+  Mesh fine;                            // The subdivided input mesh.
+  Eigen::Matrix3Xd normals;             // Its unit normals, along which k displaces.
+  std::vector<ImageGaussians> images;   // One per camera; the energy refers to them.
+  std::unique_ptr<FrameEnergy> energy;  // Over the surface Gaussians of the refined vertices.
+  long num_image_gaussians = 0;
+  double seconds = 0.0;
+};
+
+// Subdivision, visibility, image Gaussians, surface Gaussians and pair lists of one frame.
+PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options);
+
+struct FrameResult {
+  Mesh refined;              // The fine mesh with the displacement applied.
+  Eigen::Matrix3Xd normals;  // Unit normals of `refined`.
+  Eigen::VectorXd k;         // Per fine vertex, metres (bias included); NaN where not refined.
+  Eigen::VectorXd k_solved;  // Per surface Gaussian, as solved (for warm starts).
+  SolverSummary summary;
+  bool worse = false;       // The solve ended with a lower energy than it started from.
+  bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
+                            // camera sees any refined vertex).
+  int num_surface_gaussians = 0;
+  long num_image_gaussians = 0;
+  long num_pairs = 0;
+  double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
+  double seconds_total = 0.0;        // The whole frame.
+};
+
+// What bias compensation adds along the normal to every solved displacement of a frame that was
+// refined: sigma_hat with RefineOptions::bias_compensation, else 0. A kept input gets nothing.
+double BiasCompensation(const RefineOptions& options);
+
+// The one rule that takes a frame's written displacement (FrameResult::k, or its saved k/ file)
+// back to where its solve ended, per fine vertex: k minus the bias compensation, except for a frame
+// whose input was kept (`kept_input`), whose 0 is the input surface as the solver would start it.
+// NaN stays NaN. This is what seeds the next frame (warm start) and where a result's energy is
+// measured.
+Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
+                                   const RefineOptions& options);
+
+// Puts the input surface back into `result` (its refined mesh, normals and k, which becomes 0
+// wherever it was refined) and sets kept_input, for a frame that another measure than the energy
+// found worse. `fine_input` is the frame's subdivided input mesh.
+void KeepInputSurface(const Mesh& fine_input, FrameResult* result);
+
+// Where a frame's solve starts: `warm_start` when given and of the right size, else the plane
+// sweep's result (zero when the sweep is off).
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start);
+
+// Refines one frame, through the coarse-to-fine levels when configured. `warm_start` (may be
+// null) is a previous frame's k_solved.
+FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
+                        const FrameInput& input, const RefineOptions& options,
+                        const Eigen::VectorXd* warm_start = nullptr);
+
+// RefineFrame, starting from `start`: one displacement per fine vertex, metres, as solved
+// (before bias compensation); NaN where there is none, and those vertices start where RefineFrame
+// would start them (at zero, or where the plane sweep puts them). This is how a frame is seeded
+// from another frame's saved result: a fine vertex keeps its id over the sequence, while the
+// surface Gaussians of two frames may differ. Throws Error when `start` has not one entry per
+// fine vertex.
+FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
+                            const FrameInput& input, const RefineOptions& options,
+                            const Eigen::VectorXd& start);
+
+}  // namespace finecap
+
+#endif  // FINECAP_REFINE_REFINE_H_

@@ -1,0 +1,182 @@
+// A sequence refined frame after frame into a run folder (run_folder.h): the library's frame loop.
+//
+// RefineSequence owns what a run over many frames needs beyond RefineFrame (refine.h): the
+// reference colours, computed once from the reference frame, saved with the recipe they were made
+// with and checked on every reuse; resume (a done frame is skipped, so a killed run, a second shard
+// or the same command again finishes the sequence); warm start (each frame seeded from the previous
+// frame's saved displacement, as solved: see SolvedDisplacement); the next frame read on a thread
+// of its own while this one is solved; the held-out cameras' score, with keep_input_if_worse; and
+// the errors against the capture's ground truth when it has any. It writes nothing but the run
+// folder's files and prints nothing: what a user should see is reported to a SequenceObserver.
+#ifndef FINECAP_REFINE_SEQUENCE_H_
+#define FINECAP_REFINE_SEQUENCE_H_
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "finecap/io/capture.h"
+#include "finecap/io/frame_range.h"
+#include "finecap/io/mesh_io.h"
+#include "finecap/measure/heldout_score.h"
+#include "finecap/refine/frame_reader.h"
+#include "finecap/refine/frame_stats.h"
+#include "finecap/refine/problem_size.h"
+#include "finecap/refine/refine.h"
+#include "finecap/refine/run_folder.h"
+#include "finecap/util/enum_names.h"
+
+namespace finecap {
+
+// Where the reference frame colours the surface Gaussians.
+enum class ReferenceSurface {
+  kCoarse,   // At the reference frame's input (coarse) surface, as the paper did.
+  kRefined,  // At the reference frame refined first by a similarity that needs no colours.
+};
+const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface);
+
+// How the colours that surface_color and paper compare with the images are taken and kept over a
+// sequence. The consensus similarity uses no such colours, and under it these options do nothing
+// (the colours are then taken at the coarse surface, for the figures that need some).
+struct ReferenceColorOptions {
+  // With kRefined, the reference frame is first refined with the consensus similarity and
+  // finecap's defaults for everything that a similarity tunes (ReferencePassOptions), and the
+  // colours are taken at that refined surface: at a coarse surface they belong to the wrong
+  // surface points wherever the surface has detail the input lacks. Default kRefined.
+  ReferenceSurface reference_surface = ReferenceSurface::kRefined;
+  // Rate r at which the colours follow the sequence, in [0, 1]; 0 (default) keeps the reference
+  // colours for every frame (the paper). After each refined frame from the reference frame on
+  // that the run did not flag worse, every colour its refined surface shows (where a camera saw
+  // the vertex) is blended in, eta <- eta + r (eta_frame - eta), so slow changes of lighting or
+  // appearance are followed. Following is sequential: frame t uses the colours that frame t - 1
+  // left, saved in the run folder (so a resumed run continues exactly), and a frame whose
+  // predecessor is not done there is refused.
+  double follow_colors = 0.0;
+  // Pull of every followed colour back towards its reference colour after each update,
+  // eta <- eta + a (eta_reference - eta), in [0, 1]: what keeps the errors of one frame's surface
+  // from accumulating frame after frame (drift). A steady change of the images is followed to
+  // the share r (1 - a) / (r + a - r a) of it; the reference colour remains the anchor.
+  // Default 0.1.
+  double follow_anchor = 0.1;
+
+  bool following() const { return follow_colors > 0.0; }
+  void Check() const;
+};
+
+struct SequenceOptions {
+  // How each frame is refined. Its lengths should be resolved from the scene first
+  // (ResolveSceneScaleDefaults, scene_scale.h).
+  RefineOptions refine;
+  // The frame whose images colour the surface Gaussians of every frame (model.reference_frame).
+  // Default 0.
+  int reference_frame = 0;
+  // How the colours are taken and kept over the sequence.
+  ReferenceColorOptions colors;
+  // Cameras that refinement never sees (not even for the reference colours): each frame's result
+  // and input are scored in them, and with refine.keep_input_if_worse a result that scores worse
+  // than its input is replaced by the input. Default none.
+  std::vector<std::string> held_out_cameras;
+  HeldOutOptions held_out_score;
+  // Refine a frame without a camera whose image cannot be read (reported to the observer) instead
+  // of failing. Default false.
+  bool skip_unreadable_cameras = false;
+  // How the refined meshes are written. Default PLY.
+  MeshFormat mesh_format = MeshFormat::kPly;
+
+  void Check() const;
+};
+
+// Everything the reference colours depend on (ComputeSequenceColors, and the held-out cameras it
+// must not see), as one line of `name=value` fields: two runs whose recipes are equal may share
+// one file of reference colours.
+std::string ReferenceColorRecipe(const SequenceOptions& options);
+
+// The options with which the reference frame is refined before it colours the surface (with
+// ReferenceSurface::kRefined): finecap's defaults (the consensus similarity, which needs no
+// colours), their lengths resolved for `capture`'s scene, with the configured subdivision and
+// regulariser neighbourhood (the sequence's model is built with those) and threads. Not the
+// configured similarity's own settings: those of surface_color (a 35 degree view cap, no sweep,
+// chromaticity) leave most patches with fewer than the two cameras consensus needs.
+RefineOptions ReferencePassOptions(const RefineOptions& configured, const Capture& capture,
+                                   int reference_frame);
+
+// What the followed colours saved after a frame depend on: ReferenceColorRecipe and the two
+// follow options.
+std::string FollowedColorRecipe(const SequenceOptions& options);
+
+// `previous` (the colours frame t used) updated by frame t's own colours `frame` (taken at its
+// refined surface) and pulled towards `reference`, as ReferenceColorOptions says; only where
+// `reference` is valid. Returns `previous` pulled towards the reference only, where `frame` has
+// no valid colour.
+ReferenceColors FollowColors(const ReferenceColors& previous, const ReferenceColors& frame,
+                             const ReferenceColors& reference,
+                             const ReferenceColorOptions& options);
+
+// The reference colours saved at `path`, or, when there is no such file, those of the reference
+// frame (at its coarse or refined surface, options.colors.reference_surface), computed, saved
+// there with their recipe and read back (so that a run uses exactly what a
+// later resumed run or shard reads). A saved file made with another recipe throws Error naming
+// `path` and the fields that differ (a file saved before recipes were is checked on its colour
+// space, sigma_hat and method). Cameras skipped in the reference frame go to *skipped (may be
+// null).
+ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
+                                             const SequenceOptions& options, Capture* capture,
+                                             const std::string& path,
+                                             std::vector<SkippedCamera>* skipped = nullptr);
+
+// The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
+// vector when the capture has no true surface for the frame.
+Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
+                                     const Mesh& coarse, int frame);
+
+// Where a done frame's solve ended, per fine vertex (SolvedDisplacement of its saved
+// displacement, kept_input read from its record): what seeds the next frame with warm start.
+Eigen::VectorXd ReadSolvedDisplacement(const FrameFiles& files, int num_fine_vertices,
+                                       const RefineOptions& options);
+
+// What RefineSequence tells its caller while it runs; every method does nothing unless
+// overridden. Called on the caller's thread.
+class SequenceObserver {
+ public:
+  virtual ~SequenceObserver() = default;
+  // Temporaries that a killed run left in the run folder were removed, before anything else.
+  virtual void StaleFilesRemoved(int /*count*/) {}
+  // Before the first frame: the frames to run (done ones included), the first frame's input as
+  // refinement sees it and the size of its problem.
+  virtual void Starting(int /*num_frames*/, const FrameInput& /*first*/,
+                        const ProblemSize& /*size*/) {}
+  // A camera's image of `frame` could not be read and the frame goes on without it
+  // (skip_unreadable_cameras).
+  virtual void CameraSkipped(const std::string& /*frame*/, const SkippedCamera& /*camera*/) {}
+  // No camera sees any vertex to refine in `frame`: its input surface is written.
+  virtual void NothingToRefine(const std::string& /*frame*/) {}
+  // A frame was found done in the run folder and skipped.
+  virtual void FrameAlreadyDone(const std::string& /*frame*/) {}
+  // A frame was refined and its files written; `stats` is its record.
+  virtual void FrameRefined(const FrameStats& /*stats*/) {}
+};
+
+struct SequenceResult {
+  int refined = 0;       // Frames refined by this call.
+  int already_done = 0;  // Frames found done and skipped.
+  // Over the frames refined now that have ground truth (`measured` of them): the root mean square
+  // of their per-frame RMS errors (textured region), input and refined, millimetres; NaN when none.
+  int measured = 0;
+  double rms_coarse_mm = 0.0;
+  double rms_refined_mm = 0.0;
+};
+
+// Refines frames [frames.begin, frames.end) of `capture` into the run folder `out`, which must
+// exist (its subfolders are created); frames already done there are skipped. The topology and the
+// refined vertices are those of frame 0. Several processes may run on one folder at once with
+// disjoint frames (shards). Throws Error (options.Check(), unreadable input, a reference colour
+// file of another recipe) before a frame's files are written, never leaving one half-written.
+// `observer` may be null.
+SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
+                              const SequenceOptions& options, const std::string& out,
+                              SequenceObserver* observer = nullptr);
+
+}  // namespace finecap
+
+#endif  // FINECAP_REFINE_SEQUENCE_H_

@@ -1,0 +1,48 @@
+// What the evaluation of a run (run_evaluation.h) reports of the held-out cameras: figures per
+// frame and pooled, pictures, their JSON and their report section.
+#ifndef FINECAP_SRC_HELDOUT_EVAL_H_
+#define FINECAP_SRC_HELDOUT_EVAL_H_
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "finecap/eval/html_report.h"
+#include "finecap/measure/heldout_score.h"
+#include "finecap/refine/refine.h"
+
+namespace finecap {
+namespace internal {
+
+// The held-out score of one frame: surface 0 is the subdivided input mesh, surface 1 the refined
+// mesh as written.
+struct HeldOutFrame {
+  std::string frame;
+  HeldOutScore score;
+};
+
+// Scores `input` and `refined` in the views of `frame` named in `held_out_cameras` (training
+// views: the rest of `frame`), writes one picture per held-out view to
+// eval_dir/heldout_<frame>_<camera>.png and appends its path and caption to `*pictures`.
+HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
+                                  const HeldOutOptions& options, const std::string& frame_name,
+                                  FrameInput frame, const Mesh& input, const Mesh& refined,
+                                  const std::string& eval_dir,
+                                  std::vector<std::pair<std::string, std::string>>* pictures);
+
+// The means over every frame's held-out views, per surface (input, refined).
+std::vector<SurfaceScore> PooledHeldOutScore(const std::vector<HeldOutFrame>& frames);
+
+// JSON members for metrics.json: the pooled figures ("heldout_ncc_input", ...) and, per frame,
+// a "heldout" object with the frame's means and its views.
+std::string HeldOutPooledJson(const std::vector<HeldOutFrame>& frames, const std::string& indent);
+std::string HeldOutFrameJson(const HeldOutFrame& frame);
+
+// The report's table of held-out figures: pooled, per frame and per view.
+void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOptions& options,
+                       HtmlReport* report);
+
+}  // namespace internal
+}  // namespace finecap
+
+#endif  // FINECAP_SRC_HELDOUT_EVAL_H_

@@ -1,0 +1,90 @@
+#include "finecap/refine/frame_reader.h"
+
+#include <algorithm>
+
+#include "finecap/util/error.h"
+
+namespace finecap {
+
+FrameInput ReadFrameInput(Capture* capture, int frame) {
+  return ReadFrameInput(capture, frame, false, nullptr);
+}
+
+FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
+                          std::vector<SkippedCamera>* skipped) {
+  FrameInput input;
+  input.coarse = capture->ReadCoarseMesh(frame);
+  std::string first_error;
+  for (int c = 0; c < capture->num_cameras(); ++c) {
+    const Camera& camera = capture->cameras()[c];
+    try {
+      input.images.push_back(capture->ReadImage(c, frame));
+      input.cameras.push_back(camera);
+    } catch (const Error& error) {
+      if (!skip_unreadable) throw;
+      if (first_error.empty()) first_error = error.what();
+      if (skipped != nullptr) skipped->push_back({camera.name, error.what()});
+    }
+  }
+  Require(!input.cameras.empty(), "",
+          first_error + " (and no other camera's image of frame " + capture->frame_name(frame) +
+              " could be read either)");
+  return input;
+}
+
+std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& held_out,
+                                              FrameInput* input) {
+  std::vector<CalibratedImage> views;
+  FrameInput training;
+  training.coarse = std::move(input->coarse);
+  for (size_t c = 0; c < input->cameras.size(); ++c) {
+    const std::string& name = input->cameras[c].name;
+    if (std::find(held_out.begin(), held_out.end(), name) != held_out.end()) {
+      views.push_back({input->cameras[c], input->images[c]});
+    } else {
+      training.cameras.push_back(input->cameras[c]);
+      training.images.push_back(input->images[c]);
+    }
+  }
+  *input = std::move(training);
+  Require(!input->cameras.empty(), "validation.cameras",
+          "no camera other than the held-out ones could be read");
+  return views;
+}
+
+std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
+  std::vector<CalibratedImage> views;
+  for (size_t c = 0; c < input.cameras.size(); ++c) {
+    views.push_back({input.cameras[c], input.images[c]});
+  }
+  return views;
+}
+
+FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable)
+    : capture_(capture), skip_unreadable_(skip_unreadable) {}
+
+void FrameReadAhead::ReadAhead(int frame) {
+  if (pending_.valid()) return;
+  pending_frame_ = frame;
+  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+}
+
+FrameInput FrameReadAhead::Take(int frame, std::vector<SkippedCamera>* skipped) {
+  if (pending_.valid() && pending_frame_ == frame) {
+    Frame read = pending_.get();
+    *skipped = std::move(read.skipped);
+    return std::move(read.input);
+  }
+  pending_ = {};  // Waits for a read of another frame, and drops it.
+  Frame read = Read(frame);
+  *skipped = std::move(read.skipped);
+  return std::move(read.input);
+}
+
+FrameReadAhead::Frame FrameReadAhead::Read(int frame) {
+  Frame read;
+  read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
+  return read;
+}
+
+}  // namespace finecap

@@ -1,0 +1,318 @@
+#include "finecap/refine/refine.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+
+#include "energy/consensus_similarity.h"
+#include "finecap/energy/frame_energy.h"
+#include "finecap/geometry/render.h"
+#include "finecap/util/error.h"
+
+namespace finecap {
+namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vector<int>& coarse_mask,
+                             int num_coarse_vertices) {
+  std::vector<int> ids;
+  if (coarse_mask.empty()) {
+    for (int v = 0; v < stencil.num_fine_vertices(); ++v) ids.push_back(v);
+    return ids;
+  }
+  std::vector<bool> coarse(num_coarse_vertices, false);
+  for (int v : coarse_mask) coarse[v] = true;
+  const std::vector<bool> fine = SubdivideVertexMask(stencil, coarse);
+  for (int v = 0; v < static_cast<int>(fine.size()); ++v) {
+    if (fine[v]) ids.push_back(v);
+  }
+  return ids;
+}
+
+const RefineOptions& Checked(const RefineOptions& options) {
+  options.Check();
+  return options;
+}
+
+}  // namespace
+
+SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
+                             const RefineOptions& options, const std::string& where)
+    : stencil_(BuildLoopSubdivision(first_coarse, Checked(options).subdivision_levels, where)),
+      num_coarse_vertices_(first_coarse.num_vertices()) {
+  refined_vertices_ = FineMaskIds(stencil_, coarse_mask, num_coarse_vertices_);
+  const Mesh fine = ApplySubdivision(stencil_, first_coarse.vertices);
+  neighbourhoods_ = BuildVertexNeighbourhoods(fine, options.energy.reg_rings, where);
+}
+
+std::vector<int> SequenceModel::SubdivideIds(const std::vector<int>& coarse_ids) const {
+  if (coarse_ids.empty()) return {};
+  return FineMaskIds(stencil_, coarse_ids, num_coarse_vertices_);
+}
+
+Mesh SequenceModel::Subdivide(const Mesh& coarse) const {
+  return ApplySubdivision(stencil_, coarse.vertices);
+}
+
+std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
+                                                               const Eigen::Matrix3Xd& normals,
+                                                               const std::vector<Camera>& cameras,
+                                                               const VisibilityOptions& options) {
+  std::vector<std::vector<unsigned char>> visible(cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const DepthMap depth = RenderDepth(cameras[c], mesh);
+    visible[c] = ComputeVisibility(cameras[c], depth.depth, mesh.vertices, normals, options);
+  }
+  return visible;
+}
+
+ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
+                                      const RefineOptions& options) {
+  return ComputeSurfaceColors(model.Subdivide(reference.coarse), reference, options);
+}
+
+ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
+                                     const RefineOptions& options) {
+  options.Check();
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
+  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility);
+  if (options.reference_colors == ReferenceColorSource::kImageModel) {
+    std::vector<std::string> names;
+    for (const Camera& camera : frame.cameras) names.push_back(camera.name);
+    const std::vector<ImageGaussians> images =
+        BuildFrameImageGaussians(frame.images, {}, options.image, names);
+    return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
+                                       options.sigma_hat, options.energy.overlap,
+                                       options.energy.reach_sigmas);
+  }
+  return ComputeReferenceColors(fine.vertices, normals, frame.cameras, frame.images, visible,
+                                options.image.color_space, options.sigma_hat);
+}
+
+namespace {
+
+// PrepareFrame without checking `options`: the coarse levels of a schedule widen sigma_hat and the
+// leaves past the ranges that a configured value must lie in.
+PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  PreparedFrame frame;
+  frame.fine = model.Subdivide(input.coarse);
+  frame.normals = ComputeVertexNormals(frame.fine);
+  const auto visible =
+      ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
+  std::vector<std::string> names;
+  for (const Camera& camera : input.cameras) names.push_back(camera.name);
+  frame.images = BuildFrameImageGaussians(input.images, {}, options.image, names);
+
+  // The consensus similarity compares the cameras of this frame with each other; the colours
+  // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this
+  // frame's own, taken as the reference frame's are, so no frame depends on another's surface.
+  const ReferenceColors frame_colors =
+      options.energy.similarity == SimilarityType::kConsensus
+          ? ComputeModelReferenceColors(frame.fine.vertices, frame.normals, input.cameras,
+                                        frame.images, visible, options.sigma_hat,
+                                        options.energy.overlap, options.energy.reach_sigmas)
+          : colors;
+  SurfaceGaussians surface = MakeSurfaceGaussians(frame.fine.vertices, frame.normals,
+                                                  model.refined_vertices(), frame_colors);
+  std::vector<CameraInput> cameras(input.cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    cameras[c].camera = input.cameras[c];
+    cameras[c].image = &frame.images[c];
+    for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
+    frame.num_image_gaussians += frame.images[c].size();
+  }
+  frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
+                                               options.energy);
+  frame.seconds = SecondsSince(start);
+  return frame;
+}
+
+}  // namespace
+
+PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
+                           const FrameInput& input, const RefineOptions& options) {
+  options.Check();
+  return PrepareLevel(model, colors, input, options);
+}
+
+namespace {
+
+// Solve, and for the consensus similarity the further passes with patches shaped like the surface
+// found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
+// so that `worse` compares the frame by the energy it ended with.
+SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
+                               Eigen::VectorXd* k) {
+  const Eigen::VectorXd start = *k;
+  SolverSummary summary = Solve(energy, options.solver, k);
+  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
+  if (consensus == nullptr) return summary;
+  for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
+    consensus->SetPatchShape(*k);
+    const SolverSummary more = Solve(energy, options.solver, k);
+    summary.energy_end = more.energy_end;
+    summary.ls_cost_end = more.ls_cost_end;
+    summary.iterations += more.iterations;
+    summary.evaluations += more.evaluations;
+    summary.seconds += more.seconds;
+    summary.seconds_evaluation += more.seconds_evaluation;
+    summary.seconds_linear_solver += more.seconds_linear_solver;
+    summary.termination = more.termination;
+    summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
+  }
+  if (options.energy.consensus.passes > 1) {
+    // Both ends by the same sum: the solver's own (Ceres') may differ from it in the last digit.
+    EvaluateEnergyAndCost(energy, start, &summary.energy_start, &summary.ls_cost_start);
+    EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
+  }
+  return summary;
+}
+
+// Where the solve of a prepared frame starts: one k per surface Gaussian of `energy`.
+using StartingPointFunction = std::function<Eigen::VectorXd(FrameEnergy* energy)>;
+
+// Level `level` of the coarse-to-fine schedule (0: the configured options): wider surface
+// Gaussians and larger image Gaussians, so that the energy is smoother in k and a fold further
+// than a Gaussian's width from the input surface is still within reach.
+RefineOptions LevelOptions(const RefineOptions& options, int level) {
+  RefineOptions level_options = options;
+  const double factor = std::pow(options.coarse_to_fine.scale, level);
+  level_options.sigma_hat *= factor;
+  // Leaves grow with the level up to the largest an image model has.
+  level_options.image.min_leaf_size =
+      std::clamp(static_cast<int>(std::lround(options.image.min_leaf_size * factor)), 1,
+                 ImageGaussianOptions::kMaxMinLeafSize);
+  return level_options;
+}
+
+// The coarse levels of the schedule, coarsest first, each starting where the last one ended.
+// Returns the k to start the configured level from; adds the work done to *totals.
+Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const StartingPointFunction& starting_point,
+                                  SolverSummary* totals, double* seconds_preparation) {
+  Eigen::VectorXd k;
+  for (int level = options.coarse_to_fine.levels - 1; level >= 1; --level) {
+    const RefineOptions level_options = LevelOptions(options, level);
+    ReferenceColors level_colors = colors;
+    level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
+    PreparedFrame frame = PrepareLevel(model, level_colors, input, level_options);
+    *seconds_preparation += frame.seconds;
+    if (k.size() == 0) k = starting_point(frame.energy.get());
+    const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
+    totals->iterations += summary.iterations;
+    totals->evaluations += summary.evaluations;
+    totals->seconds += summary.seconds;
+    totals->seconds_evaluation += summary.seconds_evaluation;
+    totals->seconds_linear_solver += summary.seconds_linear_solver;
+  }
+  return k;
+}
+
+// RefineFrame, starting each level that does not continue from a coarser one at
+// `starting_point`.
+FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
+                                  const FrameInput& input, const RefineOptions& options,
+                                  const StartingPointFunction& starting_point) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  FrameResult result;
+  SolverSummary coarse;
+  const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
+                                                     &coarse, &result.seconds_preparation);
+
+  PreparedFrame frame = PrepareLevel(model, colors, input, options);
+  FrameEnergy& energy = *frame.energy;
+  result.num_surface_gaussians = energy.num_parameters();
+  result.num_image_gaussians = frame.num_image_gaussians;
+  result.num_pairs = energy.num_pairs();
+  result.seconds_preparation += frame.seconds;
+
+  // The frame got worse or better against where it started, before any level moved it.
+  const Eigen::VectorXd initial = starting_point(&energy);
+  Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
+  result.summary = SolveFrameEnergy(&energy, options, &k);
+  if (coarse_k.size() > 0) {
+    EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
+                          &result.summary.ls_cost_start);
+    EvaluateEnergyAndCost(&energy, k, &result.summary.energy_end, &result.summary.ls_cost_end);
+    result.summary.iterations += coarse.iterations;
+    result.summary.evaluations += coarse.evaluations;
+    result.summary.seconds += coarse.seconds;
+    result.summary.seconds_evaluation += coarse.seconds_evaluation;
+    result.summary.seconds_linear_solver += coarse.seconds_linear_solver;
+  }
+  result.k_solved = k;
+  result.worse = result.summary.energy_end < result.summary.energy_start;
+  // With no surface Gaussian (no camera sees a refined vertex) the input is all there is.
+  result.kept_input = (result.worse && options.keep_input_if_worse) || k.size() == 0;
+
+  const double bias = BiasCompensation(options);
+  result.refined = frame.fine;
+  result.k = Eigen::VectorXd::Constant(frame.fine.num_vertices(), std::nan(""));
+  const std::vector<int>& ids = energy.surface().vertex_ids;
+  for (size_t s = 0; s < ids.size(); ++s) {
+    const double displacement = result.kept_input ? 0.0 : k[s] + bias;
+    result.k[ids[s]] = displacement;
+    result.refined.vertices.col(ids[s]) += displacement * frame.normals.col(ids[s]);
+  }
+  result.normals = ComputeVertexNormals(result.refined);
+  result.seconds_total = SecondsSince(start);
+  return result;
+}
+
+}  // namespace
+
+double BiasCompensation(const RefineOptions& options) {
+  return options.bias_compensation ? options.sigma_hat : 0.0;
+}
+
+Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
+                                   const RefineOptions& options) {
+  if (kept_input) return k;
+  return k.array() - BiasCompensation(options);
+}
+
+void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
+  result->refined = fine_input;
+  result->normals = ComputeVertexNormals(fine_input);
+  result->k = result->k.array().isFinite().select(0.0 * result->k, result->k);
+  result->kept_input = true;
+}
+
+Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+                              const Eigen::VectorXd* warm_start) {
+  if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
+  return SweepInitialization(energy, sweep);
+}
+
+FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
+                        const FrameInput& input, const RefineOptions& options,
+                        const Eigen::VectorXd* warm_start) {
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    return StartingPoint(energy, options.sweep, warm_start);
+  });
+}
+
+FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
+                            const FrameInput& input, const RefineOptions& options,
+                            const Eigen::VectorXd& start) {
+  Require(start.size() == model.num_fine_vertices(), "refine",
+          "a start of " + std::to_string(start.size()) + " displacements for " +
+              std::to_string(model.num_fine_vertices()) + " fine vertices");
+  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
+    Eigen::VectorXd k = SweepInitialization(energy, options.sweep);
+    const std::vector<int>& ids = energy->surface().vertex_ids;
+    for (size_t s = 0; s < ids.size(); ++s) {
+      if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];
+    }
+    return k;
+  });
+}
+
+}  // namespace finecap

@@ -1,0 +1,468 @@
+#include "finecap/refine/sequence.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "finecap/measure/metrics.h"
+#include "finecap/solvers/solver_trace.h"
+#include "finecap/util/atomic_file.h"
+#include "finecap/util/error.h"
+#include "measure/ground_truth.h"
+#include "refine/scene_scale.h"
+
+namespace finecap {
+namespace {
+
+namespace fs = std::filesystem;
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The `name=value` fields of a recipe line.
+std::vector<std::string> RecipeFields(const std::string& recipe) {
+  std::istringstream words(recipe);
+  std::vector<std::string> fields;
+  for (std::string field; words >> field;) fields.push_back(field);
+  return fields;
+}
+
+// The fields of `saved` that `wanted` has otherwise, "a=1 (asked: a=2), ...".
+std::string RecipeDifference(const std::string& saved, const std::string& wanted) {
+  const std::vector<std::string> old_fields = RecipeFields(saved),
+                                 new_fields = RecipeFields(wanted);
+  std::string text;
+  for (size_t i = 0; i < std::max(old_fields.size(), new_fields.size()); ++i) {
+    const std::string was = i < old_fields.size() ? old_fields[i] : "(none)";
+    const std::string asked = i < new_fields.size() ? new_fields[i] : "(none)";
+    if (was != asked) text += (text.empty() ? "" : ", ") + was + " (asked: " + asked + ")";
+  }
+  return text;
+}
+
+// A saved file of reference colours fits `options`: by its recipe, or, for a file saved before
+// recipes were, by the three fields it holds.
+void RequireSameRecipe(const ReferenceColors& saved, const SequenceOptions& options,
+                       const std::string& path) {
+  if (!saved.recipe.empty()) {
+    const std::string wanted = ReferenceColorRecipe(options);
+    Require(
+        saved.recipe == wanted, path,
+        "was made with " + RecipeDifference(saved.recipe, wanted) + ": use another output folder");
+    return;
+  }
+  const RefineOptions& refine = options.refine;
+  // The file holds sigma_hat to 9 significant digits, which a length chosen from the scene needs
+  // all of.
+  Require(saved.color_space == refine.image.color_space &&
+              std::abs(saved.sigma_hat - refine.sigma_hat) <= 1e-8 * refine.sigma_hat &&
+              saved.method == refine.reference_colors,
+          path,
+          "was made with colour space " + ColorSpaceName(saved.color_space) + ", sigma_hat " +
+              std::to_string(saved.sigma_hat) + " and method " + EnumToString(saved.method) +
+              ", but the config asks for " + ColorSpaceName(refine.image.color_space) + ", " +
+              std::to_string(refine.sigma_hat) + " and " + EnumToString(refine.reference_colors) +
+              ": use another output folder");
+}
+
+// Whether the colours are taken at the refined reference surface: only when the similarity
+// compares colours, since consensus would refine the reference frame for nothing.
+bool TakesColorsAtRefinedSurface(const SequenceOptions& options) {
+  return options.colors.reference_surface == ReferenceSurface::kRefined &&
+         options.refine.energy.similarity != SimilarityType::kConsensus;
+}
+
+// Whether each frame's colours follow the ones before (pointless under consensus).
+bool FollowsColors(const SequenceOptions& options) {
+  return options.colors.following() &&
+         options.refine.energy.similarity != SimilarityType::kConsensus;
+}
+
+// The reference frame's colours, at its coarse or first refined surface.
+ReferenceColors ComputeReferenceFrameColors(const SequenceModel& model,
+                                            const SequenceOptions& options, Capture* capture,
+                                            const FrameInput& reference) {
+  if (!TakesColorsAtRefinedSurface(options)) {
+    return ComputeSequenceColors(model, reference, options.refine);
+  }
+  const RefineOptions pass =
+      ReferencePassOptions(options.refine, *capture, options.reference_frame);
+  // The consensus similarity takes its colours from the frame itself: none are passed in.
+  const FrameResult refined = RefineFrame(model, ReferenceColors{}, reference, pass);
+  return ComputeSurfaceColors(refined.refined, reference, options.refine);
+}
+
+// The refined vertices outside and inside the capture's textureless region.
+struct Regions {
+  std::vector<int> textured, textureless;
+};
+
+Regions SplitByTexture(const SequenceModel& model, const Capture& capture) {
+  std::vector<bool> textureless(model.num_fine_vertices(), false);
+  for (int v : model.SubdivideIds(capture.textureless_vertices())) textureless[v] = true;
+  Regions regions;
+  for (int v : model.refined_vertices()) {
+    (textureless[v] ? regions.textureless : regions.textured).push_back(v);
+  }
+  return regions;
+}
+
+void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, const Mesh& coarse,
+                          int frame, const Regions& regions, const FrameResult& result,
+                          FrameStats* stats) {
+  const Eigen::VectorXd truth = TrueFineDisplacement(capture, model, coarse, frame);
+  if (truth.size() == 0) return;
+  // Only where the result has a displacement: both figures over the same vertices.
+  const Eigen::VectorXd input = result.k.array().isFinite().select(0.0 * result.k, result.k);
+  stats->rms_coarse_mm = 1000.0 * ComputeErrorStats(input, truth, regions.textured).rms;
+  stats->rms_refined_mm = 1000.0 * ComputeErrorStats(result.k, truth, regions.textured).rms;
+  stats->rms_textureless_coarse_mm =
+      1000.0 * ComputeErrorStats(input, truth, regions.textureless).rms;
+  stats->rms_textureless_refined_mm =
+      1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
+}
+
+// The held-out score of the frame's input and of its result (as solved), into `stats`; a result
+// whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
+// replaced by the input.
+void ScoreInHeldOutViews(const SequenceOptions& options, const SequenceModel& model,
+                         const FrameInput& input, const std::vector<CalibratedImage>& held_out,
+                         FrameResult* result, FrameStats* stats) {
+  if (held_out.empty()) return;
+  const auto start = std::chrono::steady_clock::now();
+  const Mesh fine_input = model.Subdivide(input.coarse);
+  const HeldOutScore score = ScoreHeldOutViews(
+      CalibratedImagesOf(input), held_out, {&fine_input, &result->refined}, options.held_out_score);
+  stats->heldout_ncc_input = score.mean[0].ncc;
+  stats->heldout_ncc_refined = score.mean[1].ncc;
+  stats->heldout_mad_input = score.mean[0].mad;
+  stats->heldout_mad_refined = score.mean[1].mad;
+  stats->seconds_heldout = SecondsSince(start);
+  if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
+  result->worse = stats->worse = true;
+  if (options.refine.keep_input_if_worse && !result->kept_input) {
+    KeepInputSurface(fine_input, result);
+    stats->kept_input = true;
+  }
+}
+
+// With refine.warm_start: the solved displacement of the frame before `frame`, which seeds
+// `frame`; empty when that frame is not done in `out` (the frame then starts as a first frame).
+// Always from the saved files, so that a resumed run or a shard seeds its first frame exactly as
+// a run that never stopped seeds every frame.
+Eigen::VectorXd WarmStart(const std::string& out, const Capture& capture, int frame,
+                          const SequenceOptions& options, const SequenceModel& model) {
+  if (!options.refine.warm_start || frame == 0) return {};
+  const FrameFiles previous = FrameFilesIn(out, capture.frame_name(frame - 1), options.mesh_format);
+  if (!FrameDone(previous)) return {};
+  return ReadSolvedDisplacement(previous, model.num_fine_vertices(), options.refine);
+}
+
+// Writes the frame's files, its record last (it marks the frame done).
+void WriteFrame(const FrameFiles& files, const FrameResult& result, MeshFormat format,
+                FrameStats* stats, std::chrono::steady_clock::time_point start,
+                const StatsLog& log) {
+  const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
+  WriteMesh(files.mesh, result.refined, {result.normals, {}, quality}, format);
+  WriteDisplacement(files.displacement, result.k);
+  WriteTextFileAtomically(files.trace, SolverTraceCsv(result.summary.trace));
+  stats->seconds = SecondsSince(start);
+  const std::string record = ToJson(*stats);
+  WriteTextFileAtomically(files.stats, record + "\n");
+  log.Append(record);
+}
+
+// One run over the frames: what stays fixed while they are refined.
+class SequenceRun {
+ public:
+  SequenceRun(Capture* capture, const SequenceOptions& options, const std::string& out,
+              SequenceObserver* observer)
+      : capture_(capture),
+        options_(options),
+        out_(out),
+        observer_(observer),
+        log_(out, capture->frame_names(), options.mesh_format),
+        model_(capture->ReadCoarseMesh(0), capture->vertex_mask(), options.refine,
+               capture->mesh_path(0)),
+        reference_colors_(LoadColors()),
+        regions_(SplitByTexture(model_, *capture)),
+        reader_(capture, options.skip_unreadable_cameras) {}
+
+  void Run(const FrameRange& frames, SequenceResult* result) {
+    if (!FollowsColors(options_)) RequireNoFollowedColors();
+    ReportProblemSize(frames);
+    double sum_coarse2 = 0.0, sum_refined2 = 0.0;
+    for (int frame = frames.begin; frame < frames.end; ++frame) {
+      if (Done(frame)) {
+        observer_->FrameAlreadyDone(capture_->frame_name(frame));
+        ++result->already_done;
+        continue;
+      }
+      const FrameStats stats = RefineOne(frame, frames);
+      ++result->refined;
+      if (std::isfinite(stats.rms_refined_mm)) {
+        sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
+        sum_refined2 += stats.rms_refined_mm * stats.rms_refined_mm;
+        ++result->measured;
+      }
+      observer_->FrameRefined(stats);
+    }
+    result->rms_coarse_mm = std::sqrt(sum_coarse2 / result->measured);
+    result->rms_refined_mm = std::sqrt(sum_refined2 / result->measured);
+  }
+
+ private:
+  ReferenceColors LoadColors() {
+    std::vector<SkippedCamera> skipped;
+    ReferenceColors colors = LoadOrComputeReferenceColors(model_, options_, capture_,
+                                                          ReferenceColorsPath(out_), &skipped);
+    ReportSkipped(options_.reference_frame, skipped);
+    return colors;
+  }
+
+  void ReportSkipped(int frame, const std::vector<SkippedCamera>& skipped) {
+    for (const SkippedCamera& camera : skipped) {
+      observer_->CameraSkipped(capture_->frame_name(frame), camera);
+    }
+  }
+
+  // The size of the first frame's problem and what it forecasts, before the long part of the run.
+  void ReportProblemSize(const FrameRange& frames) {
+    FrameInput first = ReadFrameInput(capture_, frames.begin);
+    TakeHeldOutViews(options_.held_out_cameras, &first);  // Refine never sees them.
+    observer_->Starting(frames.size(), first,
+                        EstimateProblemSize(model_, reference_colors_, first, options_.refine));
+  }
+
+  bool Done(int frame) const {
+    return FrameDone(FrameFilesIn(out_, capture_->frame_name(frame), options_.mesh_format));
+  }
+
+  // A folder whose frames followed their colours cannot be continued with fixed colours.
+  void RequireNoFollowedColors() const {
+    const std::string folder = FollowedColorsFolder(out_);
+    Require(!fs::exists(folder) || fs::is_empty(folder), folder,
+            "holds the colours of a run with model.follow_colors, but this config keeps the "
+            "colours fixed: use another output folder");
+  }
+
+  // The colours `frame` is refined with: the reference colours, or, when they follow the
+  // sequence, those that the frame before left in the run folder.
+  ReferenceColors ColorsFor(int frame) const {
+    if (!FollowsColors(options_) || frame <= options_.reference_frame) return reference_colors_;
+    const std::string& previous = capture_->frame_name(frame - 1);
+    Require(Done(frame - 1), out_,
+            "model.follow_colors: frame " + capture_->frame_name(frame) +
+                " follows the colours that frame " + previous +
+                " leaves, which is not done here; following is sequential: refine the frames in "
+                "order from the reference frame, without shards");
+    const std::string path = FollowedColorsPath(out_, previous);
+    Require(fs::exists(path), path,
+            "is missing: frame " + previous +
+                " was refined without model.follow_colors; use another output folder");
+    ReferenceColors colors = ReadReferenceColors(path, model_.num_fine_vertices());
+    const std::string wanted = FollowedColorRecipe(options_);
+    Require(
+        colors.recipe == wanted, path,
+        "was made with " + RecipeDifference(colors.recipe, wanted) + ": use another output folder");
+    return colors;
+  }
+
+  // Saves the colours the frame after `name` is refined with: `used` followed towards the
+  // colours of the frame's refined surface, or `used` as it was when the frame was flagged worse.
+  void SaveFollowedColors(const std::string& name, const ReferenceColors& used,
+                          const FrameInput& input, const FrameResult& result, bool worse) const {
+    ReferenceColors next = used;
+    if (!worse) {
+      next = FollowColors(used, ComputeSurfaceColors(result.refined, input, options_.refine),
+                          reference_colors_, options_.colors);
+    }
+    next.recipe = FollowedColorRecipe(options_);
+    WriteReferenceColors(FollowedColorsPath(out_, name), next);
+  }
+
+  // Starts reading the first frame after `frame` that is still to do.
+  void ReadAheadAfter(int frame, const FrameRange& frames) {
+    for (int next = frame + 1; next < frames.end; ++next) {
+      if (Done(next)) continue;
+      reader_.ReadAhead(next);
+      return;
+    }
+  }
+
+  FrameStats RefineOne(int frame, const FrameRange& frames) {
+    const std::string& name = capture_->frame_name(frame);
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<SkippedCamera> skipped;
+    FrameInput input = reader_.Take(frame, &skipped);
+    ReportSkipped(frame, skipped);
+    const std::vector<CalibratedImage> held_out =
+        TakeHeldOutViews(options_.held_out_cameras, &input);
+    ReadAheadAfter(frame, frames);
+    const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
+    const ReferenceColors colors = ColorsFor(frame);
+    FrameResult result = warm_start.size() > 0
+                             ? RefineFrameFrom(model_, colors, input, options_.refine, warm_start)
+                             : RefineFrame(model_, colors, input, options_.refine);
+    if (result.num_surface_gaussians == 0) observer_->NothingToRefine(name);
+
+    FrameStats stats = MakeFrameStats(name, options_.refine, result);
+    for (const SkippedCamera& camera : skipped) stats.skipped_cameras.push_back(camera.camera);
+    ScoreInHeldOutViews(options_, model_, input, held_out, &result, &stats);
+    AddGroundTruthErrors(*capture_, model_, input.coarse, frame, regions_, result, &stats);
+    // Before the record, which marks the frame done: a done frame always has them.
+    if (FollowsColors(options_) && frame >= options_.reference_frame) {
+      SaveFollowedColors(name, colors, input, result, stats.worse);
+    }
+    WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
+               start, log_);
+    return stats;
+  }
+
+  Capture* capture_;
+  const SequenceOptions& options_;
+  const std::string out_;
+  SequenceObserver* observer_;
+  const StatsLog log_;
+  const SequenceModel model_;
+  const ReferenceColors reference_colors_;
+  const Regions regions_;
+  FrameReadAhead reader_;
+};
+
+}  // namespace
+
+void SequenceOptions::Check() const {
+  refine.Check();
+  colors.Check();
+  held_out_score.Check();
+  Require(reference_frame >= 0, "SequenceOptions::reference_frame",
+          "must be >= 0, got " + std::to_string(reference_frame));
+  for (const std::string& camera : held_out_cameras) {
+    Require(!camera.empty(), "SequenceOptions::held_out_cameras", "holds an empty camera name");
+  }
+}
+
+std::string ReferenceColorRecipe(const SequenceOptions& options) {
+  const RefineOptions& refine = options.refine;
+  std::ostringstream recipe;
+  recipe.precision(17);
+  recipe << "reference_frame=" << options.reference_frame
+         << " subdivision_levels=" << refine.subdivision_levels << " sigma_hat=" << refine.sigma_hat
+         << " reference_colors=" << refine.reference_colors
+         << " color_space=" << ColorSpaceName(refine.image.color_space)
+         << " max_depth=" << refine.image.max_depth
+         << " min_leaf_size=" << refine.image.min_leaf_size
+         << " split_threshold=" << refine.image.split_threshold
+         << " depth_tolerance=" << refine.visibility.depth_tolerance
+         << " max_view_angle_deg=" << refine.visibility.max_view_angle_deg
+         << " border_margin=" << refine.visibility.border_margin
+         << " overlap=" << refine.energy.overlap << " reach_sigmas=" << refine.energy.reach_sigmas
+         << " held_out=";
+  for (size_t c = 0; c < options.held_out_cameras.size(); ++c) {
+    recipe << (c == 0 ? "" : ",") << options.held_out_cameras[c];
+  }
+  // Only when refined, so that the recipes of files saved before the choice existed still fit.
+  if (TakesColorsAtRefinedSurface(options)) {
+    recipe << " reference_surface=refined reg_rings=" << refine.energy.reg_rings;
+  }
+  return recipe.str();
+}
+
+std::string FollowedColorRecipe(const SequenceOptions& options) {
+  std::ostringstream recipe;
+  recipe.precision(17);
+  recipe << ReferenceColorRecipe(options) << " follow_colors=" << options.colors.follow_colors
+         << " follow_anchor=" << options.colors.follow_anchor;
+  return recipe.str();
+}
+
+RefineOptions ReferencePassOptions(const RefineOptions& configured, const Capture& capture,
+                                   int reference_frame) {
+  RefineOptions pass;
+  pass.subdivision_levels = configured.subdivision_levels;
+  pass.energy.reg_rings = configured.energy.reg_rings;
+  pass.energy.consensus.patch_rings =
+      std::min(pass.energy.consensus.patch_rings, pass.energy.reg_rings);
+  pass.solver.num_threads = configured.solver.num_threads;
+  ResolveSceneScaleDefaults(capture, reference_frame, &pass);
+  return pass;
+}
+
+ReferenceColors FollowColors(const ReferenceColors& previous, const ReferenceColors& frame,
+                             const ReferenceColors& reference,
+                             const ReferenceColorOptions& options) {
+  const size_t n = reference.colors.size();
+  Require(previous.colors.size() == n && frame.colors.size() == n, "FollowColors",
+          "colours of " + std::to_string(previous.colors.size()) + " and " +
+              std::to_string(frame.colors.size()) + " vertices for a reference of " +
+              std::to_string(n));
+  const float rate = static_cast<float>(options.follow_colors);
+  const float anchor = static_cast<float>(options.follow_anchor);
+  ReferenceColors next = previous;
+  for (size_t v = 0; v < n; ++v) {
+    if (!reference.valid[v]) continue;
+    Eigen::Vector3f color = previous.colors[v];
+    if (frame.valid[v]) color += rate * (frame.colors[v] - color);
+    next.colors[v] = color + anchor * (reference.colors[v] - color);
+  }
+  return next;
+}
+
+ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
+                                             const SequenceOptions& options, Capture* capture,
+                                             const std::string& path,
+                                             std::vector<SkippedCamera>* skipped) {
+  if (fs::exists(path)) {
+    ReferenceColors saved = ReadReferenceColors(path, model.num_fine_vertices());
+    RequireSameRecipe(saved, options, path);
+    return saved;
+  }
+  Require(options.reference_frame < capture->num_frames(), "model.reference_frame",
+          "frame " + std::to_string(options.reference_frame) + " does not exist in " +
+              capture->directory());
+  FrameInput reference =
+      ReadFrameInput(capture, options.reference_frame, options.skip_unreadable_cameras, skipped);
+  TakeHeldOutViews(options.held_out_cameras, &reference);  // Held-out cameras colour nothing.
+  ReferenceColors colors = ComputeReferenceFrameColors(model, options, capture, reference);
+  colors.recipe = ReferenceColorRecipe(options);
+  WriteReferenceColors(path, colors);
+  // As saved: every run and shard on this folder then starts from the very same colours.
+  return ReadReferenceColors(path, model.num_fine_vertices());
+}
+
+Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
+                                     const Mesh& coarse, int frame) {
+  if (!capture.HasTrueSurface(frame)) return {};
+  const Mesh fine = model.Subdivide(coarse);
+  return TrueDisplacementAlongNormals(fine.vertices, ComputeVertexNormals(fine),
+                                      capture.ReadTrueSurface(frame), 0.1);
+}
+
+Eigen::VectorXd ReadSolvedDisplacement(const FrameFiles& files, int num_fine_vertices,
+                                       const RefineOptions& options) {
+  return SolvedDisplacement(ReadDisplacement(files.displacement, num_fine_vertices),
+                            ReadFrameStats(files.stats).kept_input, options);
+}
+
+SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
+                              const SequenceOptions& options, const std::string& out,
+                              SequenceObserver* observer) {
+  options.Check();
+  SequenceObserver silent;
+  if (observer == nullptr) observer = &silent;
+  const int stale = PrepareRunSubfolders(out, FollowsColors(options));
+  if (stale > 0) observer->StaleFilesRemoved(stale);
+  const StatsLog log(out, capture->frame_names(), options.mesh_format);
+  log.Rebuild();
+  SequenceResult result;
+  if (frames.size() == 0) return result;
+  SequenceRun(capture, options, out, observer).Run(frames, &result);
+  log.Rebuild();
+  return result;
+}
+
+}  // namespace finecap
