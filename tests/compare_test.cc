@@ -121,7 +121,7 @@ TEST(ComparisonTest, SummaryMatchesAHandComputation) {
   std::vector<VariantSummary> rows = {row, ascent};
   EXPECT_EQ(ReferenceVariant(rows, ""), 1);  // The first gradient ascent by default.
   EXPECT_EQ(ReferenceVariant(rows, "v"), 0);
-  ExpectErrorMentions([&] { ReferenceVariant(rows, "w"); }, {"compare.reference", "'w'"});
+  ExpectErrorMentions([&] { ReferenceVariant(rows, "w"); }, {"reference variant", "'w'"});
   SetTimeRatios(1, &rows);
   EXPECT_DOUBLE_EQ(rows[0].time_ratio, 0.5);
   EXPECT_DOUBLE_EQ(rows[1].time_ratio, 1.0);

@@ -129,6 +129,21 @@ TEST(ConfigOptionsTest, FieldsMapToTheirKeys) {
   EXPECT_EQ(ConfigKeyOfField("SynthOptions::folds[1].wavelength"), "synth.folds[1].wavelength");
   EXPECT_EQ(ConfigKeyOfField("SolverOptions::num_threads"), "");
   EXPECT_EQ(ConfigKeyOfField("RefineOptions::no_such_field"), "");
+  EXPECT_EQ(ConfigKeyOfField("SequenceOptions::reference_frame"), "model.reference_frame");
+  EXPECT_EQ(ConfigKeyOfField("SequenceOptions::held_out_cameras"), "validation.cameras");
+  EXPECT_EQ(ConfigKeyOfField("ReferenceColorOptions::follow_colors"), "model.follow_colors");
+}
+
+// The library names fields in its messages; the command line shows the keys.
+TEST(ConfigOptionsTest, MessagesOfTheLibraryReadInConfigKeys) {
+  EXPECT_EQ(InConfigTerms("2.02e+05 times RefineOptions::sigma_hat = 0.007; lower "
+                          "RefineOptions::sigma_hat (and EnergyOptions::k_max)"),
+            "2.02e+05 times model.sigma_hat = 0.007; lower model.sigma_hat (and energy.k_max)");
+  EXPECT_EQ(InConfigTerms("SynthOptions::folds[1].wavelength: must be positive"),
+            "synth.folds[1].wavelength: must be positive");
+  // A field that no key holds, and text without fields, stay as they are.
+  EXPECT_EQ(InConfigTerms("SolverOptions::num_threads: is 0"), "SolverOptions::num_threads: is 0");
+  EXPECT_EQ(InConfigTerms("no field here"), "no field here");
 }
 
 // A rule across keys is the struct's Check()'s; the config reports it at the key.

@@ -201,8 +201,8 @@ TEST(SceneScale, MeasuresTheBoundingBoxAgainstSigmaHat) {
   EXPECT_NO_THROW(RequirePlausibleSceneScale(Square(1.0), 0.007, "m.ply"));
   // The same square in millimetres: 202,000 sigma_hat.
   ExpectErrorMentions([] { RequirePlausibleSceneScale(Square(1000.0), 0.007, "mm.ply"); },
-                      {"mm.ply", "1414 across", "2.02e+05 times model.sigma_hat", "millimetres",
-                       "convert the capture"});
+                      {"mm.ply", "1414 across", "2.02e+05 times RefineOptions::sigma_hat",
+                       "millimetres", "convert the capture"});
   // 1 cm: 2 sigma_hat, the Gaussians would cover it whole.
   ExpectErrorMentions([] { RequirePlausibleSceneScale(Square(0.01), 0.007, "tiny.ply"); },
                       {"tiny.ply", "2.02 times", "too small", "0.035 m"});

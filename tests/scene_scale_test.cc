@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
+#include "finecap/config/config.h"
 #include "finecap/io/capture.h"
 #include "test_meshes.h"
 
@@ -86,7 +87,8 @@ TEST(SceneScale, LengthsFollowTheSceneUnlessSet) {
   EXPECT_NEAR(options.solver.initial_step, factors.initial_step * s, 1e-12);
   EXPECT_NEAR(options.solver.max_step, factors.max_step * s, 1e-12);
   ASSERT_EQ(defaults.lengths.size(), 5u);
-  for (const ChosenLength& length : defaults.lengths) EXPECT_TRUE(length.from_scene) << length.key;
+  for (const ChosenLength& length : defaults.lengths)
+    EXPECT_TRUE(length.from_scene) << length.field;
   EXPECT_NO_THROW(options.Check());
 
   // Resolving again changes nothing.
@@ -115,11 +117,16 @@ TEST(SceneScale, LengthsFollowTheSceneUnlessSet) {
   const SceneScaleDefaults chosen = ResolveSceneScaleDefaults(grid, {camera}, "grid.ply", &set);
   EXPECT_EQ(set.sigma_hat, 0.004);
   EXPECT_FALSE(chosen.lengths[0].from_scene);
-  EXPECT_EQ(chosen.lengths[0].key, "model.sigma_hat");
+  EXPECT_EQ(chosen.lengths[0].field, "RefineOptions::sigma_hat");
   EXPECT_NEAR(set.energy.k_max, options.energy.k_max, 1e-12);
   const std::string text = DescribeSceneScaleDefaults(chosen);
-  EXPECT_NE(text.find("model.sigma_hat 4 mm (set)"), std::string::npos) << text;
-  EXPECT_NE(text.find("energy.k_max"), std::string::npos) << text;
+  EXPECT_NE(text.find("RefineOptions::sigma_hat 4 mm (set)"), std::string::npos) << text;
+  EXPECT_NE(text.find("EnergyOptions::k_max"), std::string::npos) << text;
+  // The command line reads the same line in config keys.
+  const std::string keys = InConfigTerms(text);
+  EXPECT_NE(keys.find("model.sigma_hat 4 mm (set)"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("energy.k_max"), std::string::npos) << keys;
+  EXPECT_EQ(keys.find("Options::"), std::string::npos) << keys;
   EXPECT_NE(text.find("(auto)"), std::string::npos) << text;
 }
 

@@ -229,7 +229,7 @@ int main(int argc, char** argv) {
   try {
     return finecap::Main(argc, argv);
   } catch (const finecap::Error& error) {
-    std::cerr << "finecap: error: " << error.what() << "\n";
+    std::cerr << "finecap: error: " << finecap::InConfigTerms(error.what()) << "\n";
   } catch (const std::exception& error) {
     std::cerr << "finecap: internal error: " << error.what() << "\n";
   }

@@ -70,7 +70,8 @@ Config WithSceneLengths(const Config& config, const Capture& capture, const std:
   Config resolved = config;
   const SceneScaleDefaults chosen =
       ResolveSceneScaleDefaults(capture, config.reference_frame, &resolved.refine);
-  std::cerr << "finecap " << command << ": " << DescribeSceneScaleDefaults(chosen) << "\n";
+  std::cerr << "finecap " << command << ": " << InConfigTerms(DescribeSceneScaleDefaults(chosen))
+            << "\n";
   if (defaults != nullptr) *defaults = chosen;
   resolved.refine.Check();
   return resolved;

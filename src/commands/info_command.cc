@@ -90,8 +90,8 @@ int RunInfo(const Config& configured) {
   std::cout << "lengths:";
   for (size_t i = 0; i < defaults.lengths.size(); ++i) {
     const ChosenLength& length = defaults.lengths[i];
-    std::cout << (i ? ", " : " ") << length.key << " " << LengthText(length.value)
-              << (length.from_scene ? " (auto)" : " (set)");
+    std::cout << (i ? ", " : " ") << ConfigKeyOfField(length.field) << " "
+              << LengthText(length.value) << (length.from_scene ? " (auto)" : " (set)");
   }
   std::cout << "\n";
   std::cout << "vertices refined: " << size.num_surface_gaussians << " of "

@@ -1,6 +1,9 @@
 #include "finecap/config/config.h"
 
+#include <map>
+#include <regex>
 #include <sstream>
+#include <string>
 
 #include <yaml-cpp/yaml.h>
 
@@ -317,6 +320,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& FieldSectio
       {"SweepOptions::", {"refine.sweep."}},
       {"CoarseToFineOptions::", {"refine.coarse_to_fine."}},
       {"HeldOutOptions::", {"validation."}},
+      {"SequenceOptions::", {"model.", "refine.", "validation."}},
+      {"RunEvaluationOptions::", {"model.", "eval."}},
       {"SynthOptions::", {"synth."}},
       {"SkirtOptions::", {"synth.skirt."}},
       {"TextureOptions::", {"synth.texture."}},
@@ -336,11 +341,17 @@ bool IsKeyOrPart(const std::string& path, const ConfigSchema& schema) {
   }
 }
 
-}  // namespace
+// Fields whose key is not their section and name.
+const std::map<std::string, std::string>& RenamedFields() {
+  static const std::map<std::string, std::string> renamed = {
+      {"SequenceOptions::held_out_cameras", "validation.cameras"},
+      {"RunEvaluationOptions::held_out_cameras", "validation.cameras"}};
+  return renamed;
+}
 
-std::string ConfigKeyOfField(const std::string& field) {
-  Config defaults;
-  const ConfigSchema schema = MakeConfigSchema(&defaults);
+std::string ConfigKeyOfField(const std::string& field, const ConfigSchema& schema) {
+  const auto renamed = RenamedFields().find(field);
+  if (renamed != RenamedFields().end()) return renamed->second;
   for (const auto& [prefix, sections] : FieldSections()) {
     if (field.rfind(prefix, 0) != 0) continue;
     for (const std::string& section : sections) {
@@ -349,6 +360,31 @@ std::string ConfigKeyOfField(const std::string& field) {
     }
   }
   return "";
+}
+
+}  // namespace
+
+std::string ConfigKeyOfField(const std::string& field) {
+  Config defaults;
+  return ConfigKeyOfField(field, MakeConfigSchema(&defaults));
+}
+
+std::string InConfigTerms(const std::string& text) {
+  // "RefineOptions::sigma_hat", "SynthOptions::folds[1].wavelength".
+  static const std::regex field(
+      R"([A-Z][A-Za-z]*::[a-z_][a-z_0-9]*(\[[0-9]+\](\.[a-z_][a-z_0-9]*)*)?)");
+  Config defaults;
+  const ConfigSchema schema = MakeConfigSchema(&defaults);
+  std::string result;
+  auto last = text.cbegin();
+  for (std::sregex_iterator match(text.begin(), text.end(), field), end; match != end; ++match) {
+    const std::string key = ConfigKeyOfField(match->str(), schema);
+    result.append(last, (*match)[0].first);
+    result += key.empty() ? match->str() : key;
+    last = (*match)[0].second;
+  }
+  result.append(last, text.cend());
+  return result;
 }
 
 void CheckConfig(const Config& config, const std::string& source) {

@@ -105,7 +105,7 @@ int ReferenceVariant(const std::vector<VariantSummary>& rows, const std::string&
       return static_cast<int>(i);
     }
   }
-  Require(reference.empty(), "compare.reference", "'" + reference + "' is not a variant");
+  Require(reference.empty(), "reference variant", "'" + reference + "' is not a variant");
   return 0;
 }
 

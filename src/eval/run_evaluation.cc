@@ -131,7 +131,7 @@ FlowSetup PrepareFlow(const RunEvaluationOptions& options, const SequenceModel& 
   for (int c = 0; c < capture->num_cameras(); ++c) {
     if (options.flow_in_all_cameras || c == options.camera) setup.cameras.push_back(c);
   }
-  Require(options.reference_frame < capture->num_frames(), "model.reference_frame",
+  Require(options.reference_frame < capture->num_frames(), "RunEvaluationOptions::reference_frame",
           "frame " + std::to_string(options.reference_frame) + " does not exist in " +
               capture->directory());
   const FrameInput reference = ReadFrameInput(capture, options.reference_frame);
@@ -383,7 +383,7 @@ void AddFlowTable(const EvaluationRun& run, HtmlReport* report) {
       "Mean length of the optical flow from a render of the model, textured from the reference "
       "frame's images, to the input image, over the pixels where the model shows refined "
       "vertices (no ground truth needed; the paper's section 7). Improvement: 100 (input - "
-      "refined) / input. n/a: not measured (eval.flow: none).");
+      "refined) / input. n/a: not measured (no flow evaluation).");
   if (run.refined_flow_texture == RefinedFlowTexture::kRefinedReferenceMesh) {
     report->AddParagraph(
         "Each mesh is textured from its own surface in the reference frame: the input mesh from "

@@ -47,7 +47,7 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
     }
   }
   *input = std::move(training);
-  Require(!input->cameras.empty(), "validation.cameras",
+  Require(!input->cameras.empty(), "SequenceOptions::held_out_cameras",
           "no camera other than the held-out ones could be read");
   return views;
 }

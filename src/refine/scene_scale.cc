@@ -47,10 +47,10 @@ double MedianPixelFootprint(const Mesh& mesh, const std::vector<Camera>& cameras
 }
 
 // Replaces `*value` by max(factor * scene length, at_least) when `from_scene`, and reports it.
-ChosenLength Choose(const std::string& key, double factor, double scene_length, double* value,
+ChosenLength Choose(const std::string& field, double factor, double scene_length, double* value,
                     bool from_scene, double at_least = 0.0) {
   if (from_scene) *value = std::max(factor * scene_length, at_least);
-  return {key, *value, from_scene};
+  return {field, *value, from_scene};
 }
 
 }  // namespace
@@ -90,25 +90,27 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
   const SceneLengthFactors factors;
   const SceneLengths& marks = options->scene_lengths;
   defaults.lengths = {
-      Choose("model.sigma_hat",
+      Choose("RefineOptions::sigma_hat",
              options->energy.similarity == SimilarityType::kConsensus
                  ? factors.sigma_hat
                  : factors.single_gaussian_sigma_hat,
              s, &options->sigma_hat, marks.sigma_hat),
-      Choose("energy.k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
+      Choose("EnergyOptions::k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
              factors.k_max_of_diagonal * defaults.scale.diagonal),
-      Choose("visibility.depth_tolerance", factors.depth_tolerance, s,
+      Choose("VisibilityOptions::depth_tolerance", factors.depth_tolerance, s,
              &options->visibility.depth_tolerance, marks.depth_tolerance),
-      Choose("solver.initial_step", factors.initial_step, s, &options->solver.initial_step,
+      Choose("SolverOptions::initial_step", factors.initial_step, s, &options->solver.initial_step,
              marks.initial_step),
-      Choose("solver.max_step", factors.max_step, s, &options->solver.max_step, marks.max_step),
+      Choose("SolverOptions::max_step", factors.max_step, s, &options->solver.max_step,
+             marks.max_step),
   };
   return defaults;
 }
 
 SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int reference_frame,
                                              RefineOptions* options) {
-  Require(reference_frame >= 0 && reference_frame < capture.num_frames(), "model.reference_frame",
+  Require(reference_frame >= 0 && reference_frame < capture.num_frames(),
+          "SequenceOptions::reference_frame",
           "frame " + std::to_string(reference_frame) + " does not exist in " + capture.directory() +
               " (" + std::to_string(capture.num_frames()) + " frames)");
   return ResolveSceneScaleDefaults(capture.ReadCoarseMesh(reference_frame), capture.cameras(),
@@ -123,7 +125,7 @@ std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults) {
        << " x pixel footprint " << LengthText(scale.pixel_footprint) << "); ";
   for (size_t i = 0; i < defaults.lengths.size(); ++i) {
     const ChosenLength& length = defaults.lengths[i];
-    text << (i ? ", " : "") << length.key << " " << LengthText(length.value)
+    text << (i ? ", " : "") << length.field << " " << LengthText(length.value)
          << (length.from_scene ? " (auto)" : " (set)");
   }
   return text.str();
@@ -149,17 +151,20 @@ void RequirePlausibleSceneScale(const Mesh& mesh, double sigma_hat, const std::s
   std::ostringstream problem;
   problem.precision(4);
   problem << "the coarse mesh measures " << diagonal << " across (bounding-box diagonal), "
-          << sigmas << " times model.sigma_hat = " << sigma_hat << "; finecap's lengths are metres";
+          << sigmas << " times RefineOptions::sigma_hat = " << sigma_hat
+          << "; finecap's lengths are metres";
   if (sigmas > limits.max_sigmas) {
     problem << ", and a mesh this large looks like one in millimetres or centimetres: convert the "
-               "capture (meshes and camera translations) to metres, or raise model.sigma_hat for "
+               "capture (meshes and camera translations) to metres, or raise "
+               "RefineOptions::sigma_hat for "
                "a subject larger than "
             << limits.max_sigmas * sigma_hat << " m";
   } else {
-    problem << ", and a mesh this small is too small for the surface Gaussians (or in a larger "
-               "unit than metres): convert the capture to metres, or lower model.sigma_hat (and "
-               "energy.k_max) for a subject smaller than "
-            << limits.min_sigmas * sigma_hat << " m";
+    problem
+        << ", and a mesh this small is too small for the surface Gaussians (or in a larger "
+           "unit than metres): convert the capture to metres, or lower RefineOptions::sigma_hat "
+           "(and EnergyOptions::k_max) for a subject smaller than "
+        << limits.min_sigmas * sigma_hat << " m";
   }
   throw Error(where, problem.str());
 }

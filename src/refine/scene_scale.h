@@ -78,7 +78,7 @@ SceneScale MeasureSceneScale(const Mesh& fine, const std::vector<Camera>& camera
 
 // One length of RefineOptions as a run uses it.
 struct ChosenLength {
-  std::string key;          // Its config key, e.g. "model.sigma_hat".
+  std::string field;        // The options field, e.g. "RefineOptions::sigma_hat".
   double value = 0.0;       // Metres.
   bool from_scene = false;  // Followed from the scene (else set explicitly).
 };
@@ -105,7 +105,8 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Capture& capture, int referen
 std::string LengthText(double metres);
 
 // A line that says what was chosen and from what, e.g. "scene length 9.9 mm (mean edge 9.9 mm,
-// pixel footprint 3.0 mm); model.sigma_hat 6.93 mm (from the scene), energy.k_max 20 mm (set)".
+// pixel footprint 3.0 mm); RefineOptions::sigma_hat 6.93 mm (from the scene), EnergyOptions::k_max
+// 20 mm (set)".
 std::string DescribeSceneScaleDefaults(const SceneScaleDefaults& defaults);
 
 struct SceneScaleLimits {

@@ -245,7 +245,8 @@ class SequenceRun {
   void RequireNoFollowedColors() const {
     const std::string folder = FollowedColorsFolder(out_);
     Require(!fs::exists(folder) || fs::is_empty(folder), folder,
-            "holds the colours of a run with model.follow_colors, but this config keeps the "
+            "holds the colours of a run with ReferenceColorOptions::follow_colors, but this config "
+            "keeps the "
             "colours fixed: use another output folder");
   }
 
@@ -255,14 +256,15 @@ class SequenceRun {
     if (!FollowsColors(options_) || frame <= options_.reference_frame) return reference_colors_;
     const std::string& previous = capture_->frame_name(frame - 1);
     Require(Done(frame - 1), out_,
-            "model.follow_colors: frame " + capture_->frame_name(frame) +
+            "ReferenceColorOptions::follow_colors: frame " + capture_->frame_name(frame) +
                 " follows the colours that frame " + previous +
                 " leaves, which is not done here; following is sequential: refine the frames in "
                 "order from the reference frame, without shards");
     const std::string path = FollowedColorsPath(out_, previous);
-    Require(fs::exists(path), path,
-            "is missing: frame " + previous +
-                " was refined without model.follow_colors; use another output folder");
+    Require(
+        fs::exists(path), path,
+        "is missing: frame " + previous +
+            " was refined without ReferenceColorOptions::follow_colors; use another output folder");
     ReferenceColors colors = ReadReferenceColors(path, model_.num_fine_vertices());
     const std::string wanted = FollowedColorRecipe(options_);
     Require(
@@ -421,7 +423,7 @@ ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
     RequireSameRecipe(saved, options, path);
     return saved;
   }
-  Require(options.reference_frame < capture->num_frames(), "model.reference_frame",
+  Require(options.reference_frame < capture->num_frames(), "SequenceOptions::reference_frame",
           "frame " + std::to_string(options.reference_frame) + " does not exist in " +
               capture->directory());
   FrameInput reference =

@@ -105,6 +105,11 @@ struct Config {
 // "synth.folds[1].profile", for a field inside a list); "" when no key holds it.
 std::string ConfigKeyOfField(const std::string& field);
 
+// `text` (an error or a warning of the library) with every options field it names
+// ("RefineOptions::sigma_hat") replaced by the config key that holds it ("model.sigma_hat"), so
+// that a user of the command line reads the keys they write; a field no key holds stays.
+std::string InConfigTerms(const std::string& text);
+
 // config.Check(), throwing an Error that names `source` (a file, or a variant) and, where a key
 // holds the field that failed, that key.
 void CheckConfig(const Config& config, const std::string& source);
