@@ -259,6 +259,38 @@ TEST(RegularizerTest, MatchesThePapersDoubleSumAndItsGradient) {
   EXPECT_LT((analytic - numeric).norm(), 1e-6 * numeric.norm());
 }
 
+// Averaging keeps what is smooth over the neighbourhood (a plane of k) and damps what changes from
+// one vertex to the next (a checkerboard), and a neighbour fixed at k = 0 does not pull it down.
+TEST(RegularizerTest, AveragingOverNeighboursKeepsAPlaneAndDampsACheckerboard) {
+  const Mesh mesh = GridMesh(9, 9, 0.01);
+  // Cut-off 2 edges, as by default: the one-ring carries the weight (T(2) = 0).
+  const VertexNeighbourhoods neighbourhoods = BuildVertexNeighbourhoods(mesh, 2);
+  std::vector<int> ids;
+  for (int v = 1; v < 81; ++v) ids.push_back(v);  // Vertex 0, a corner, stays fixed.
+
+  const Regularizer regularizer(neighbourhoods, ids, 2, 1000.0);
+  Eigen::MatrixXd values(ids.size(), 2);
+  for (size_t s = 0; s < ids.size(); ++s) {
+    const int x = ids[s] % 9, y = ids[s] / 9;
+    values(s, 0) = 0.001 * x - 0.002 * y + 0.003;
+    values(s, 1) = (x + y) % 2 == 0 ? 0.001 : -0.001;
+  }
+  Eigen::MatrixXd averaged = values;
+  regularizer.AverageOverNeighbours(2, &averaged);
+  for (size_t s = 0; s < ids.size(); ++s) {
+    const int x = ids[s] % 9, y = ids[s] / 9;
+    // Two rounds reach two edges: further from the border (and the fixed corner) every one-ring
+    // involved is symmetric about its vertex.
+    if (x >= 3 && x <= 5 && y >= 3 && y <= 5) {
+      EXPECT_NEAR(averaged(s, 0), values(s, 0), 1e-12) << "vertex " << ids[s];
+    }
+  }
+  EXPECT_LT(averaged.col(1).norm(), 0.5 * values.col(1).norm());
+  Eigen::MatrixXd unchanged = values;
+  regularizer.AverageOverNeighbours(0, &unchanged);
+  EXPECT_EQ(unchanged, values);
+}
+
 }  // namespace
 }  // namespace finecap
 
