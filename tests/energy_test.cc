@@ -195,6 +195,41 @@ TEST(ConsensusSimilarityTest, IgnoresEachCamerasGainAndOffset) {
   }
 }
 
+// The colour tables hold, at each node, the overlap-weighted colour and its slope that
+// ImageColorOfPairs computes directly, in every overlap form.
+TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
+  for (const std::string form : {"printed", "exact", "patch"}) {
+    EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
+    const EnergyOptions options = Options("consensus", form);
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+    const auto& consensus = dynamic_cast<const ConsensusSimilarity&>(energy.similarity());
+    const int num_nodes =
+        ConsensusSimilarity::NumTableNodes(scene.surface.sigma_hat, options.k_max);
+    const double step = 2.0 * options.k_max / (num_nodes - 1);
+    int compared = 0;
+    for (int c = 0; c < static_cast<int>(energy.views().size()); ++c) {
+      const EnergyView& view = energy.views()[c];
+      for (int row = 0; row < static_cast<int>(view.pairs.surface_ids.size()); row += 7) {
+        const Eigen::Vector3d own =
+            energy.surface().colors[view.pairs.surface_ids[row]].cast<double>();
+        // Inner nodes: at the table's ends the derivative is that of the clamped colour, zero.
+        for (int node = 1; node + 1 < num_nodes; ++node) {
+          const double k = -options.k_max + node * step;
+          Eigen::Vector3d direct_slope, tabulated_slope;
+          const Eigen::Vector3d direct = ImageColorOfPairs(view, energy.surface(), row, k,
+                                                           options.overlap, own, &direct_slope);
+          const Eigen::Vector3d tabulated = consensus.Interpolate(c, row, k, &tabulated_slope);
+          EXPECT_LT((tabulated - direct).norm(), 1e-6 * (1.0 + direct.norm())) << form;
+          EXPECT_LT((tabulated_slope - direct_slope).norm(), 1e-5 * (1.0 + direct_slope.norm()))
+              << form;
+          ++compared;
+        }
+      }
+    }
+    EXPECT_GT(compared, 20) << form;
+  }
+}
+
 // A plain surface (every image Gaussian the same colour) gives the consensus nothing to agree
 // on: no weight, no residual, no pull anywhere.
 TEST(ConsensusSimilarityTest, PlainSurfaceCarriesNoWeight) {
