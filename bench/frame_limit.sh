@@ -7,6 +7,11 @@
 #
 #   bash bench/frame_limit.sh            # 10 frames; FRAMES=5 for a quicker look
 #   SOLVER=gradient-ascent bash bench/frame_limit.sh
+#   BEFORE=../main/build/finecap RUNS=3 bash bench/frame_limit.sh
+#
+# With BEFORE (another build's finecap), both builds refine the same frames in turn, RUNS times
+# (default 3), and the before_ lines give the other build's figures beside this one's.
+# Figures are medians over the runs (whole runs) or over all the runs' frames (stages).
 #
 # Prints one "name: value" a line, seconds per frame unless the name says otherwise.
 set -euo pipefail
@@ -19,16 +24,30 @@ trap 'rm -rf "$work"' EXIT
 [ -x build/finecap ] && [ -x build/energy_benchmark ] || bash scripts/build.sh >/dev/null
 build/finecap synth --config configs/synth_skirt.yaml --out "$work/capture" \
   --set "synth.num_frames=$frames" >/dev/null
-start=$(date +%s.%N)
-build/finecap refine --capture "$work/capture" --out "$work/out" --solver "$solver" \
-  >/dev/null 2>&1
-end=$(date +%s.%N)
+runs=${RUNS:-1}
+before=${BEFORE:-}
 
-# Median over the frames of a figure in stats.jsonl.
-median_of() {
-  grep -o "\"$1\": [0-9.eE+-]*" "$work/out/stats.jsonl" | awk '{ print $2 }' | sort -g |
-    awk '{ v[NR] = $1 } END { printf "%.3f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+# Refines the capture with finecap binary $1 into $2; prints the run's frames per minute.
+refine_run() {
+  local start end
+  start=$(date +%s.%N)
+  "$1" refine --capture "$work/capture" --out "$2" --solver "$solver" >/dev/null 2>&1
+  end=$(date +%s.%N)
+  echo "$start $end" | awk -v f="$frames" '{ printf "%.1f\n", 60 * f / ($2 - $1) }'
 }
+for run in $(seq "$runs"); do
+  if [ -n "$before" ]; then refine_run "$before" "$work/before_$run" >>"$work/before_fpm"; fi
+  refine_run build/finecap "$work/out_$run" >>"$work/fpm"
+done
+
+median() {
+  sort -g | awk '{ v[NR] = $1 } END { printf "%.3f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
+}
+# A figure $1 of every frame of the runs with prefix $2 (default: this build's) in stats.jsonl.
+values_of() { cat "$work/${2:-out}"_*/stats.jsonl | grep -o "\"$1\": [0-9.eE+-]*" | awk '{ print $2 }'; }
+median_of() { values_of "$@" | median; }
+# The runs' largest peak resident memory, MB.
+peak_of() { values_of peak_rss_mb "$@" | sort -g | tail -1; }
 
 # Medians of 5 repetitions, milliseconds.
 bench=$(build/energy_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
@@ -54,6 +73,17 @@ echo "measured_preparation_s: $(median_of seconds_preparation)"
 echo "measured_solve_s: $(median_of seconds_solve)"
 echo "measured_evaluation_s: $(median_of seconds_evaluation)"
 echo "measured_linear_solver_s: $(median_of seconds_linear_solver)"
-echo "measured_run_frames_per_minute: $(echo "$start $end" |
-  awk -v f="$frames" '{ printf "%.1f", 60 * f / ($2 - $1) }')"
+echo "measured_run_frames_per_minute: $(median <"$work/fpm" | awk '{ printf "%.1f", $1 }')"
+echo "measured_rms_refined_mm: $(median_of rms_refined_mm)"
+echo "measured_peak_rss_mb: $(peak_of)"
 echo "frame_over_bound: $(awk -v t="$total" -v b="$bound" 'BEGIN { printf "%.2f", t / b }')"
+if [ -n "$before" ]; then
+  echo "before_frame_s: $(median_of seconds before)"
+  echo "before_preparation_s: $(median_of seconds_preparation before)"
+  echo "before_solve_s: $(median_of seconds_solve before)"
+  echo "before_evaluation_s: $(median_of seconds_evaluation before)"
+  echo "before_linear_solver_s: $(median_of seconds_linear_solver before)"
+  echo "before_run_frames_per_minute: $(median <"$work/before_fpm" | awk '{ printf "%.1f", $1 }')"
+  echo "before_rms_refined_mm: $(median_of rms_refined_mm before)"
+  echo "before_peak_rss_mb: $(peak_of before)"
+fi

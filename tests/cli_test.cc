@@ -134,6 +134,29 @@ TEST(CliTest, InfoPrintsTheCaptureAndWritesNothing) {
   EXPECT_NE(set.output.find("model.sigma_hat 12.3 mm (set)"), std::string::npos) << set.output;
 }
 
+// How many times libgomp loaded in a run with OMP_DISPLAY_ENV (once per process), and the wait
+// policy it showed last.
+std::pair<int, std::string> WaitPolicies(const RunResult& result) {
+  const std::string key = "OMP_WAIT_POLICY = '";
+  int count = 0;
+  std::string last;
+  for (size_t at = result.output.find(key); at != std::string::npos;
+       at = result.output.find(key, at + 1)) {
+    ++count;
+    const size_t begin = at + key.size();
+    last = result.output.substr(begin, result.output.find('\'', begin) - begin);
+  }
+  return {count, last};
+}
+
+// finecap runs itself again with sleeping OpenMP workers, unless the caller chose a policy.
+TEST(CliTest, RestartsWithSleepingWorkersUnlessAPolicyIsSet) {
+  const RunResult plain = RunFinecap("--help", "OMP_DISPLAY_ENV=true ");
+  EXPECT_EQ(WaitPolicies(plain), std::make_pair(2, std::string("PASSIVE"))) << plain.output;
+  const RunResult chosen = RunFinecap("--help", "OMP_DISPLAY_ENV=true OMP_WAIT_POLICY=active ");
+  EXPECT_EQ(WaitPolicies(chosen), std::make_pair(1, std::string("ACTIVE"))) << chosen.output;
+}
+
 TEST(CliTest, InfoForecastsTheMemoryRefinePrints) {
   const fs::path capture = TinyCapture("info_forecast");
   const RunResult info = RunFinecap("info --capture " + capture.string());

@@ -195,6 +195,41 @@ TEST(ConsensusSimilarityTest, IgnoresEachCamerasGainAndOffset) {
   }
 }
 
+// The colour tables hold, at each node, the overlap-weighted colour and its slope that
+// ImageColorOfPairs computes directly, in every overlap form.
+TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
+  for (const std::string form : {"printed", "exact", "patch"}) {
+    EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
+    const EnergyOptions options = Options("consensus", form);
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+    const auto& consensus = dynamic_cast<const ConsensusSimilarity&>(energy.similarity());
+    const int num_nodes =
+        ConsensusSimilarity::NumTableNodes(scene.surface.sigma_hat, options.k_max);
+    const double step = 2.0 * options.k_max / (num_nodes - 1);
+    int compared = 0;
+    for (int c = 0; c < static_cast<int>(energy.views().size()); ++c) {
+      const EnergyView& view = energy.views()[c];
+      for (int row = 0; row < static_cast<int>(view.pairs.surface_ids.size()); row += 7) {
+        const Eigen::Vector3d own =
+            energy.surface().colors[view.pairs.surface_ids[row]].cast<double>();
+        // Inner nodes: at the table's ends the derivative is that of the clamped colour, zero.
+        for (int node = 1; node + 1 < num_nodes; ++node) {
+          const double k = -options.k_max + node * step;
+          Eigen::Vector3d direct_slope, tabulated_slope;
+          const Eigen::Vector3d direct = ImageColorOfPairs(view, energy.surface(), row, k,
+                                                           options.overlap, own, &direct_slope);
+          const Eigen::Vector3d tabulated = consensus.Interpolate(c, row, k, &tabulated_slope);
+          EXPECT_LT((tabulated - direct).norm(), 1e-6 * (1.0 + direct.norm())) << form;
+          EXPECT_LT((tabulated_slope - direct_slope).norm(), 1e-5 * (1.0 + direct_slope.norm()))
+              << form;
+          ++compared;
+        }
+      }
+    }
+    EXPECT_GT(compared, 20) << form;
+  }
+}
+
 // A plain surface (every image Gaussian the same colour) gives the consensus nothing to agree
 // on: no weight, no residual, no pull anywhere.
 TEST(ConsensusSimilarityTest, PlainSurfaceCarriesNoWeight) {
@@ -257,6 +292,38 @@ TEST(RegularizerTest, MatchesThePapersDoubleSumAndItsGradient) {
   const Eigen::VectorXd numeric = NumericGradient(
       [&](const Eigen::VectorXd& x) { return regularizer.Evaluate(x, nullptr); }, k, 1e-7);
   EXPECT_LT((analytic - numeric).norm(), 1e-6 * numeric.norm());
+}
+
+// Averaging keeps what is smooth over the neighbourhood (a plane of k) and damps what changes from
+// one vertex to the next (a checkerboard), and a neighbour fixed at k = 0 does not pull it down.
+TEST(RegularizerTest, AveragingOverNeighboursKeepsAPlaneAndDampsACheckerboard) {
+  const Mesh mesh = GridMesh(9, 9, 0.01);
+  // Cut-off 2 edges, as by default: the one-ring carries the weight (T(2) = 0).
+  const VertexNeighbourhoods neighbourhoods = BuildVertexNeighbourhoods(mesh, 2);
+  std::vector<int> ids;
+  for (int v = 1; v < 81; ++v) ids.push_back(v);  // Vertex 0, a corner, stays fixed.
+
+  const Regularizer regularizer(neighbourhoods, ids, 2, 1000.0);
+  Eigen::MatrixXd values(ids.size(), 2);
+  for (size_t s = 0; s < ids.size(); ++s) {
+    const int x = ids[s] % 9, y = ids[s] / 9;
+    values(s, 0) = 0.001 * x - 0.002 * y + 0.003;
+    values(s, 1) = (x + y) % 2 == 0 ? 0.001 : -0.001;
+  }
+  Eigen::MatrixXd averaged = values;
+  regularizer.AverageOverNeighbours(2, &averaged);
+  for (size_t s = 0; s < ids.size(); ++s) {
+    const int x = ids[s] % 9, y = ids[s] / 9;
+    // Two rounds reach two edges: further from the border (and the fixed corner) every one-ring
+    // involved is symmetric about its vertex.
+    if (x >= 3 && x <= 5 && y >= 3 && y <= 5) {
+      EXPECT_NEAR(averaged(s, 0), values(s, 0), 1e-12) << "vertex " << ids[s];
+    }
+  }
+  EXPECT_LT(averaged.col(1).norm(), 0.5 * values.col(1).norm());
+  Eigen::MatrixXd unchanged = values;
+  regularizer.AverageOverNeighbours(0, &unchanged);
+  EXPECT_EQ(unchanged, values);
 }
 
 }  // namespace

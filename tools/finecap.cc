@@ -226,6 +226,7 @@ int Main(int argc, char** argv) {
 }  // namespace finecap
 
 int main(int argc, char** argv) {
+  finecap::RestartWithSleepingWorkers(argv);
   try {
     return finecap::Main(argc, argv);
   } catch (const finecap::Error& error) {

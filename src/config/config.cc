@@ -205,6 +205,11 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                  "Consensus similarity: solves per frame, each later one with patches shaped "
                  "like the surface the one before found.",
                  1, 10);
+  schema->AddInt("energy.consensus.shape_smoothing_rounds",
+                 &energy->consensus.shape_smoothing_rounds,
+                 "Consensus similarity: rounds of averaging over mesh neighbours of the surface a "
+                 "pass found before it shapes the next pass's patches (0: as found).",
+                 0, 100);
   schema->AddInt("energy.consensus.patch_rings", &energy->consensus.patch_rings,
                  "Consensus similarity: a patch is a surface Gaussian and its neighbours up to "
                  "this many edges away (at most energy.reg_rings).",

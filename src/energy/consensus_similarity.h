@@ -74,12 +74,36 @@ class ConsensusSimilarity : public SimilarityTerm {
   // One entry per surface Gaussian; zero (the input surface) until set.
   void SetPatchShape(const Eigen::VectorXd& shape);
 
+  // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk (when not null). At
+  // the tables' nodes it is ImageColorOfPairs (surface_color_similarity.h) in single precision;
+  // between them a cubic Hermite interpolation.
+  Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
+
   // The weight w_s of each block, per channel (the patch's contrast at the input surface).
   const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
 
  private:
+  // A node's colour and its slope (dcolour/dk times node_step_, the Hermite tangent) side by
+  // side: an interpolation reads two neighbouring nodes, 48 contiguous bytes. In single
+  // precision: the tables are the similarity's largest part, and colours carry 8 bits.
+  struct TableNode {
+    Eigen::Vector3f color;
+    Eigen::Vector3f slope;
+  };
+  // An image Gaussian of a pair, in the form the tables' overlaps read it.
+  struct PairedImageGaussian {
+    Eigen::Vector2d mean;
+    double variance;         // sigma_i^2.
+    double scaled_variance;  // Its share of S: ImageVarianceFactor(form) sigma_i^2.
+    Eigen::Vector3d color;
+  };
+
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
+  // The nodes of one row of `view`'s pair list: ImageColorOfPairs at each node, with the row's
+  // image Gaussians gathered once (into `paired`) instead of once per node.
+  void TabulateRow(const EnergyView& view, int row, std::vector<PairedImageGaussian>* paired,
+                   TableNode* nodes) const;
   // Colours of every row of every camera's pair list at one k, [c][row].
   using RowColors = std::vector<std::vector<Eigen::Vector3d>>;
   // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
@@ -88,8 +112,6 @@ class ConsensusSimilarity : public SimilarityTerm {
   void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
                    std::vector<Eigen::Vector3d>* derivatives,
                    const RowColors* row_colors = nullptr) const;
-  // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk.
-  Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
   // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
@@ -114,13 +136,6 @@ class ConsensusSimilarity : public SimilarityTerm {
   // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
   double node_k0_ = 0.0, node_step_ = 1.0;
   int num_nodes_ = 0;
-  // A node's colour and its slope (dcolour/dk times node_step_, the Hermite tangent) side by
-  // side: an interpolation reads two neighbouring nodes, 48 contiguous bytes. In single
-  // precision: the tables are the similarity's largest part, and colours carry 8 bits.
-  struct TableNode {
-    Eigen::Vector3f color;
-    Eigen::Vector3f slope;
-  };
   std::vector<std::vector<TableNode>> table_;
   Eigen::VectorXd shape_;
 

@@ -45,6 +45,7 @@ void ConsensusOptions::Check() const {
   RequireFieldRange(contrast_floor, 1e-6, 1.0, "ConsensusOptions::contrast_floor");
   RequireFieldRange(min_cameras, 2, 64, "ConsensusOptions::min_cameras");
   RequireFieldRange(passes, 1, 10, "ConsensusOptions::passes");
+  RequireFieldRange(shape_smoothing_rounds, 0, 100, "ConsensusOptions::shape_smoothing_rounds");
   RequireFieldRange(patch_rings, 1, 4, "ConsensusOptions::patch_rings");
   RequireFieldRange(robust_fraction, 0.0, 100.0, "ConsensusOptions::robust_fraction");
 }

@@ -38,4 +38,20 @@ double Regularizer::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient
   return energy;
 }
 
+void Regularizer::AverageOverNeighbours(int rounds, Eigen::MatrixXd* values) const {
+  const int n = static_cast<int>(values->rows());
+  for (int round = 0; round < rounds; ++round) {
+    Eigen::MatrixXd sum = *values;
+    Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
+    for (const Pair& pair : pairs_) {
+      if (pair.b < 0) continue;
+      sum.row(pair.a) += values->row(pair.b);
+      sum.row(pair.b) += values->row(pair.a);
+      count[pair.a] += 1.0;
+      count[pair.b] += 1.0;
+    }
+    *values = sum.array().colwise() / count.array();
+  }
+}
+
 }  // namespace finecap

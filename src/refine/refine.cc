@@ -153,7 +153,11 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
   auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
   if (consensus == nullptr) return summary;
   for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
-    consensus->SetPatchShape(*k);
+    // The window's displacement, not each member's noise about it (ConsensusOptions).
+    Eigen::MatrixXd shape = *k;
+    energy->regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
+                                                &shape);
+    consensus->SetPatchShape(shape.col(0));
     const SolverSummary more = Solve(energy, options.solver, k);
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;

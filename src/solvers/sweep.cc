@@ -26,23 +26,6 @@ Eigen::MatrixXd SweepCosts(FrameEnergy* energy, const Eigen::VectorXd& displacem
   return costs;
 }
 
-// Each round replaces a Gaussian's cost curve by the mean of its own and its neighbours'.
-void SmoothOverNeighbours(const Regularizer& regularizer, int rounds, Eigen::MatrixXd* costs) {
-  const int n = static_cast<int>(costs->rows());
-  for (int round = 0; round < rounds; ++round) {
-    Eigen::MatrixXd sum = *costs;
-    Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
-    for (const Regularizer::Pair& pair : regularizer.pairs()) {
-      if (pair.b < 0) continue;
-      sum.row(pair.a) += costs->row(pair.b);
-      sum.row(pair.b) += costs->row(pair.a);
-      count[pair.a] += 1.0;
-      count[pair.b] += 1.0;
-    }
-    *costs = sum.array().colwise() / count.array();
-  }
-}
-
 }  // namespace
 
 Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options) {
@@ -52,7 +35,7 @@ Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& opt
   const double k_max = energy->options().k_max;
   const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
   Eigen::MatrixXd costs = SweepCosts(energy, displacements);
-  SmoothOverNeighbours(energy->regularizer(), options.smoothing_rounds, &costs);
+  energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];
   Eigen::VectorXd k(n);
   for (int s = 0; s < n; ++s) {

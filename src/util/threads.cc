@@ -1,6 +1,9 @@
 #include "finecap/util/threads.h"
 
 #include <omp.h>
+#include <unistd.h>
+
+#include <cstdlib>
 
 #include "finecap/util/error.h"
 
@@ -11,6 +14,12 @@ void SetWorkerThreads(int threads) {
   // OpenMP's own default, remembered before anything changes it.
   static const int default_threads = omp_get_max_threads();
   omp_set_num_threads(threads > 0 ? threads : default_threads);
+}
+
+void RestartWithSleepingWorkers(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  execv("/proc/self/exe", argv);  // Returns only if it failed.
 }
 
 }  // namespace finecap

@@ -38,6 +38,10 @@ class Regularizer {
 
   // Every unordered pair once; E_reg = 2 sum_pairs weight * (u * (k_a - k_b))^2.
   const std::vector<Pair>& pairs() const { return pairs_; }
+
+  // Replaces, `rounds` times, each row of `values` (one per surface Gaussian) by the mean of its
+  // own and those of its neighbours with a non-zero weight; fixed neighbours do not count.
+  void AverageOverNeighbours(int rounds, Eigen::MatrixXd* values) const;
   double unit_scale() const { return unit_scale_; }
 
  private:

@@ -30,9 +30,15 @@
 
 namespace finecap {
 
+// Leaves down to one pixel: the smallest image Gaussians then blur by half a pixel instead of one.
+// That blur lies on each camera's own pixel grid, so it differs between cameras and the consensus
+// similarity counts it as disagreement; next to a projected surface Gaussian of 1.3-1.7 px (the
+// synthetic studio, sigma_hat at 3 m) it was the energy's noise floor wherever the input is
+// within a pixel of the truth (the samba dancer's smoothed input: -4.9 % with 2 px leaves,
+// +16 % with 1 px; the README's consensus table). configs/surface_color.yaml keeps 2 px.
 inline ImageGaussianOptions RefinementImageOptions() {
   ImageGaussianOptions options;
-  options.min_leaf_size = 2;
+  options.min_leaf_size = 1;
   options.color_space = ColorSpace::kNormalizedRgb;
   return options;
 }

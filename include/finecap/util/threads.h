@@ -11,6 +11,15 @@ namespace finecap {
 // thread, before a parallel stage: runtime.threads of a config.
 void SetWorkerThreads(int threads);
 
+// OpenMP's workers (libgomp's default) spin for a while after each parallel loop, waiting for the
+// next. Between the loops Ceres runs its own threads and the frame reader decodes the next
+// images, and a spinning worker takes a core from them. This makes the workers sleep instead
+// (OMP_WAIT_POLICY=passive): libgomp reads the policy once, as it loads, so the process runs
+// itself again from the start with it set, `argv` unchanged. Nothing happens when the caller set
+// OMP_WAIT_POLICY or GOMP_SPINCOUNT, or after the restart; if the restart fails the process
+// goes on as it is. Call it first thing in main().
+void RestartWithSleepingWorkers(char** argv);
+
 }  // namespace finecap
 
 #endif  // FINECAP_UTIL_THREADS_H_
