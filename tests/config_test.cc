@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -150,6 +151,39 @@ TEST(ConfigTest, HelpListsEveryKeyWithItsDefault) {
   EXPECT_NE(help.find("output.mesh_format (choice ply, obj, default ply)"), std::string::npos)
       << help;
   EXPECT_NE(help.find("runtime.threads"), std::string::npos);
+}
+
+// Every config the repository ships loads as it is, and so does every variant of the compare
+// configs: a key renamed or a range narrowed breaks the files users copy first.
+TEST(ConfigTest, EveryShippedConfigAndVariantLoads) {
+  const std::filesystem::path configs = std::filesystem::path(FINECAP_SOURCE_DIR) / "configs";
+  int num_configs = 0;
+  int num_variants = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(configs)) {
+    if (entry.path().extension() != ".yaml") continue;
+    SCOPED_TRACE(entry.path().string());
+    Config config;
+    ASSERT_NO_THROW(config = LoadConfig(entry.path().string(), {}));
+    ++num_configs;
+    for (const CompareVariant& variant : config.compare.variants) {
+      SCOPED_TRACE(variant.name);
+      EXPECT_NO_THROW(VariantConfig(config, variant));
+      ++num_variants;
+    }
+  }
+  EXPECT_GT(num_configs, 0);
+  EXPECT_GT(num_variants, 0);
+}
+
+// The side-by-side comparison of the similarities selects each of the three.
+TEST(ConfigTest, CompareSimilaritiesSetsAllThree) {
+  const std::string file = std::string(FINECAP_SOURCE_DIR) + "/configs/compare_similarities.yaml";
+  const Config config = LoadConfig(file, {});
+  std::set<SimilarityType> similarities;
+  for (const CompareVariant& variant : config.compare.variants) {
+    similarities.insert(VariantConfig(config, variant).refine.energy.similarity);
+  }
+  EXPECT_EQ(similarities.size(), 3u);
 }
 
 }  // namespace
