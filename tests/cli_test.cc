@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -37,11 +39,9 @@ RunResult RunFinecapIn(const fs::path& working, const std::string& environment,
   return RunFinecap(arguments, "cd '" + working.string() + "' && " + environment + " ");
 }
 
+// Unique per process: the plain and the sanitized suites may run at the same time.
 fs::path FreshFolder(const std::string& name) {
-  const fs::path folder = fs::path(::testing::TempDir()) / ("cli_" + name);
-  fs::remove_all(folder);
-  fs::create_directories(folder);
-  return folder;
+  return finecap::testing_util::MakeTempDir("cli_" + name);
 }
 
 TEST(CliTest, HelpListsTheSubcommands) {
