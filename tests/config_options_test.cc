@@ -144,6 +144,9 @@ TEST(ConfigOptionsTest, MessagesOfTheLibraryReadInConfigKeys) {
   // A field that no key holds, and text without fields, stay as they are.
   EXPECT_EQ(InConfigTerms("SolverOptions::num_threads: is 0"), "SolverOptions::num_threads: is 0");
   EXPECT_EQ(InConfigTerms("no field here"), "no field here");
+  // Half a field name stays; a full stop after the name is not part of it.
+  EXPECT_EQ(InConfigTerms("RefineOptions:: x, lower RefineOptions::sigma_hat."),
+            "RefineOptions:: x, lower model.sigma_hat.");
 }
 
 // A rule across keys is the struct's Check()'s; the config reports it at the key.

@@ -1,7 +1,7 @@
 #include "finecap/config/config.h"
 
+#include <cctype>
 #include <map>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -367,6 +367,44 @@ std::string ConfigKeyOfField(const std::string& field, const ConfigSchema& schem
   return "";
 }
 
+bool IsMemberStart(char c) { return std::islower(static_cast<unsigned char>(c)) || c == '_'; }
+
+bool IsMemberChar(char c) {
+  return IsMemberStart(c) || std::isdigit(static_cast<unsigned char>(c));
+}
+
+// The end of a member name ([a-z_][a-z_0-9]*) that starts at `begin`, or `begin` if none does.
+size_t MemberEnd(const std::string& text, size_t begin) {
+  if (begin >= text.size() || !IsMemberStart(text[begin])) return begin;
+  size_t end = begin + 1;
+  while (end < text.size() && IsMemberChar(text[end])) ++end;
+  return end;
+}
+
+// The length of the options field named at text[begin] ("RefineOptions::sigma_hat",
+// "SynthOptions::folds[1].wavelength"), or 0 if none starts there. A hand-written scan rather
+// than std::regex, whose automaton GCC 12 warns about under the sanitizers.
+size_t FieldNameLength(const std::string& text, size_t begin) {
+  if (!std::isupper(static_cast<unsigned char>(text[begin]))) return 0;
+  size_t end = begin;
+  while (end < text.size() && std::isalpha(static_cast<unsigned char>(text[end]))) ++end;
+  if (text.compare(end, 2, "::") != 0) return 0;
+  const size_t member = end + 2;
+  end = MemberEnd(text, member);
+  if (end == member) return 0;
+  if (end < text.size() && text[end] == '[') {  // An element of a list, and its members.
+    size_t close = end + 1;
+    while (close < text.size() && std::isdigit(static_cast<unsigned char>(text[close]))) ++close;
+    if (close > end + 1 && close < text.size() && text[close] == ']') {
+      end = close + 1;
+      while (end < text.size() && text[end] == '.' && MemberEnd(text, end + 1) > end + 1) {
+        end = MemberEnd(text, end + 1);
+      }
+    }
+  }
+  return end - begin;
+}
+
 }  // namespace
 
 std::string ConfigKeyOfField(const std::string& field) {
@@ -375,20 +413,20 @@ std::string ConfigKeyOfField(const std::string& field) {
 }
 
 std::string InConfigTerms(const std::string& text) {
-  // "RefineOptions::sigma_hat", "SynthOptions::folds[1].wavelength".
-  static const std::regex field(
-      R"([A-Z][A-Za-z]*::[a-z_][a-z_0-9]*(\[[0-9]+\](\.[a-z_][a-z_0-9]*)*)?)");
   Config defaults;
   const ConfigSchema schema = MakeConfigSchema(&defaults);
   std::string result;
-  auto last = text.cbegin();
-  for (std::sregex_iterator match(text.begin(), text.end(), field), end; match != end; ++match) {
-    const std::string key = ConfigKeyOfField(match->str(), schema);
-    result.append(last, (*match)[0].first);
-    result += key.empty() ? match->str() : key;
-    last = (*match)[0].second;
+  for (size_t i = 0; i < text.size();) {
+    const size_t length = FieldNameLength(text, i);
+    if (length == 0) {
+      result += text[i++];
+      continue;
+    }
+    const std::string field = text.substr(i, length);
+    const std::string key = ConfigKeyOfField(field, schema);
+    result += key.empty() ? field : key;
+    i += length;
   }
-  result.append(last, text.cend());
   return result;
 }
 
