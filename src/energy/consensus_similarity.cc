@@ -185,14 +185,12 @@ void ConsensusSimilarity::TabulateRow(const EnergyView& view, int row,
     const ProjectedGaussian projected =
         ProjectSurfaceGaussian(view.camera, surface_.base.col(s), surface_.normals.col(s),
                                node_k0_ + node * node_step_, surface_.sigma_hat);
-    // GaussianOverlap and its k-derivative summed as ColorAccumulator does, with what depends
-    // only on the node taken out of the loop and one division per pair.
+    // GaussianOverlap and its k-derivative, with what depends only on the node taken out of the
+    // loop over the row's image Gaussians and one division per pair.
     const double var_s = projected.sigma * projected.sigma;
     const double inverse_var_s = 1.0 / var_s;
     const double dvar_dk = 2.0 * projected.sigma * projected.dsigma_dk;
-    double weight = internal::kEmptyWeight, dweight = 0.0;
-    Eigen::Vector3d weighted = internal::kEmptyWeight * fallback;
-    Eigen::Vector3d dweighted = Eigen::Vector3d::Zero();
+    internal::ColorAccumulator accumulator(fallback);
     for (const PairedImageGaussian& g : *paired) {
       const double inverse_sum = 1.0 / (var_s + g.scaled_variance);
       const Eigen::Vector2d d = g.mean - projected.mean;
@@ -201,15 +199,10 @@ void ConsensusSimilarity::TabulateRow(const EnergyView& view, int row,
       const double overlap = 2.0 * M_PI * var_s * g.variance * inverse_sum * std::exp(-spread);
       const double dlog_dvar = inverse_var_s - inverse_sum + spread * inverse_sum;
       const double dlog_dmean = 2.0 * d.dot(projected.dmean_dk) * inverse_divisor * inverse_sum;
-      const double doverlap = overlap * (dlog_dvar * dvar_dk + dlog_dmean);
-      weight += overlap;
-      weighted += overlap * g.color;
-      dweight += doverlap;
-      dweighted += doverlap * g.color;
+      accumulator.AddOverlap(overlap, overlap * (dlog_dvar * dvar_dk + dlog_dmean), g.color);
     }
-    const Eigen::Vector3d mean = weighted / weight;
-    nodes[node].color = mean.cast<float>();
-    nodes[node].slope = (node_step_ * (dweighted - mean * dweight) / weight).cast<float>();
+    nodes[node].color = accumulator.Mean().cast<float>();
+    nodes[node].slope = (node_step_ * accumulator.MeanDerivative()).cast<float>();
   }
 }
 

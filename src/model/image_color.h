@@ -33,7 +33,11 @@ class ColorAccumulator {
     double doverlap = 0.0;
     const double overlap = GaussianOverlap(form, projected, Eigen::Vector2d(g.x, g.y), g.sigma,
                                            with_derivative ? &doverlap : nullptr);
-    const Eigen::Vector3d color = g.Color().cast<double>();
+    AddOverlap(overlap, doverlap, g.Color().cast<double>());
+  }
+  // The same with the overlap and its k-derivative computed by the caller (the consensus tables
+  // take what depends only on the surface Gaussian out of their loop over image Gaussians).
+  void AddOverlap(double overlap, double doverlap, const Eigen::Vector3d& color) {
     weight_ += overlap;
     weighted_ += overlap * color;
     dweight_ += doverlap;
