@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <omp.h>
+
 #include "finecap/util/error.h"
 
 namespace finecap {
@@ -74,7 +76,12 @@ FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable,
 void FrameReadAhead::ReadAhead(int frame) {
   if (pending_.valid() || kept_frame_ == frame) return;
   pending_frame_ = frame;
-  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+  pending_ = std::async(std::launch::async, [this, frame] {
+    // One thread: the solve it overlaps has the cores, and one image modelled at a time holds
+    // one image's buffers, not one per core.
+    omp_set_num_threads(1);
+    return Read(frame);
+  });
 }
 
 void FrameReadAhead::Keep(int frame, Frame read) {
