@@ -347,6 +347,18 @@ int SizeExponent(float sigma) {
   return static_cast<int>((bits >> 23) & 0xffu) - 127;
 }
 
+// The indices of `keys` ordered by key, in their given order within a key (*order), and where
+// each key's run begins in that order (*begin, num_keys + 1 entries). Keys lie in [0, num_keys).
+void CountingSort(const std::vector<int>& keys, int num_keys, std::vector<int>* begin,
+                  std::vector<int>* order) {
+  begin->assign(num_keys + 1, 0);
+  for (int key : keys) ++(*begin)[key + 1];
+  for (int key = 0; key < num_keys; ++key) (*begin)[key + 1] += (*begin)[key];
+  std::vector<int> next(begin->begin(), begin->end() - 1);
+  order->resize(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) (*order)[next[keys[i]]++] = static_cast<int>(i);
+}
+
 }  // namespace
 
 void ImageGaussianOptions::Check() const {
@@ -379,37 +391,38 @@ ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
   }
   if (gaussians.empty()) return;
 
-  int min_exponent = SizeExponent(gaussians[0].sigma), max_exponent = min_exponent;
-  for (const ImageGaussian& g : gaussians) {
-    min_exponent = std::min(min_exponent, SizeExponent(g.sigma));
-    max_exponent = std::max(max_exponent, SizeExponent(g.sigma));
-  }
-  std::vector<std::vector<int>> members(max_exponent - min_exponent + 1);
-  for (int i = 0; i < static_cast<int>(gaussians.size()); ++i) {
-    members[SizeExponent(gaussians[i].sigma) - min_exponent].push_back(i);
-  }
+  std::vector<int> exponents(gaussians.size());
+  for (size_t i = 0; i < gaussians.size(); ++i) exponents[i] = SizeExponent(gaussians[i].sigma);
+  const auto extremes = std::minmax_element(exponents.begin(), exponents.end());
+  const int lowest = *extremes.first, num_classes = *extremes.second - lowest + 1;
+  for (int& exponent : exponents) exponent -= lowest;
+  std::vector<int> class_begin, by_class;
+  CountingSort(exponents, num_classes, &class_begin, &by_class);
   gaussians_.reserve(gaussians.size());
-  for (int k = 0; k < static_cast<int>(members.size()); ++k) {
-    if (!members[k].empty()) AppendSizeClass(gaussians, members[k], min_exponent + k);
+  for (size_t k = 0; k + 1 < class_begin.size(); ++k) {
+    const int* members = by_class.data() + class_begin[k];
+    const int count = class_begin[k + 1] - class_begin[k];
+    if (count > 0) AppendSizeClass(gaussians, members, count, lowest + static_cast<int>(k));
   }
 }
 
-void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all,
-                                     const std::vector<int>& members, int exponent) {
+void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all, const int* members,
+                                     int count, int exponent) {
   SizeClass size_class;
   size_class.begin = static_cast<int>(gaussians_.size());
   float min_x = all[members[0]].x, max_x = min_x;
   float min_y = all[members[0]].y, max_y = min_y;
-  for (int i : members) {
-    size_class.max_sigma = std::max(size_class.max_sigma, all[i].sigma);
-    min_x = std::min(min_x, all[i].x);
-    max_x = std::max(max_x, all[i].x);
-    min_y = std::min(min_y, all[i].y);
-    max_y = std::max(max_y, all[i].y);
+  for (int j = 0; j < count; ++j) {
+    const ImageGaussian& g = all[members[j]];
+    size_class.max_sigma = std::max(size_class.max_sigma, g.sigma);
+    min_x = std::min(min_x, g.x);
+    max_x = std::max(max_x, g.x);
+    min_y = std::min(min_y, g.y);
+    max_y = std::max(max_y, g.y);
   }
   // A cell the side of the class's smallest square holds about one quad-tree leaf; a class that
   // is sparse over its extent gets coarser cells, keeping the grid within ~4 cells per Gaussian.
-  const double max_cells = 4.0 * members.size() + 64.0;
+  const double max_cells = 4.0 * count + 64.0;
   size_class.cell = std::ldexp(1.0, exponent + 1);
   while ((double(max_x - min_x) / size_class.cell + 1.0) *
              (double(max_y - min_y) / size_class.cell + 1.0) >
@@ -421,15 +434,12 @@ void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all,
   size_class.cols = static_cast<int>((max_x - min_x) / size_class.cell) + 1;
   size_class.rows = static_cast<int>((max_y - min_y) / size_class.cell) + 1;
 
-  // Counting sort by cell: each cell's Gaussians, and each grid row's, end up contiguous.
-  const int num_cells = size_class.cols * size_class.rows;
-  size_class.cell_begin.assign(num_cells + 1, 0);
-  for (int i : members) ++size_class.cell_begin[size_class.CellOf(all[i]) + 1];
-  size_class.cell_begin[0] = size_class.begin;
-  for (int c = 0; c < num_cells; ++c) size_class.cell_begin[c + 1] += size_class.cell_begin[c];
-  std::vector<int> next(size_class.cell_begin.begin(), size_class.cell_begin.end() - 1);
-  gaussians_.resize(gaussians_.size() + members.size());
-  for (int i : members) gaussians_[next[size_class.CellOf(all[i])]++] = all[i];
+  // Sorted by cell: each cell's Gaussians, and each grid row's, end up contiguous.
+  std::vector<int> cells(count), by_cell;
+  for (int j = 0; j < count; ++j) cells[j] = size_class.CellOf(all[members[j]]);
+  CountingSort(cells, size_class.cols * size_class.rows, &size_class.cell_begin, &by_cell);
+  for (int& begin : size_class.cell_begin) begin += size_class.begin;
+  for (int j : by_cell) gaussians_.push_back(all[members[j]]);
   classes_.push_back(std::move(size_class));
 }
 

@@ -135,9 +135,9 @@ class ImageGaussians {
     std::pair<int, int> CellRange(double low, double high, double origin, int count) const;
   };
 
-  // Appends the Gaussians all[members], whose sigmas lie in [2^exponent, 2^(exponent+1)), as
-  // a new size class.
-  void AppendSizeClass(const std::vector<ImageGaussian>& all, const std::vector<int>& members,
+  // Appends the `count` Gaussians all[members[0 .. count)], whose sigmas lie in
+  // [2^exponent, 2^(exponent+1)), as a new size class; within a cell they keep their given order.
+  void AppendSizeClass(const std::vector<ImageGaussian>& all, const int* members, int count,
                        int exponent);
 
   // Appends the Gaussians with |mean - point|^2 <= base + sigma_factor * sigma_i^2.
