@@ -459,26 +459,34 @@ std::pair<int, int> ImageGaussians::SizeClass::CellRange(double low, double high
   return {std::max(0, clamped_cell(low)), std::min(count - 1, clamped_cell(high))};
 }
 
-void ImageGaussians::CollectNear(const Eigen::Vector2d& point, double base, double sigma_factor,
+void ImageGaussians::CollectNear(const Eigen::Vector2d& start, const Eigen::Vector2d& end,
+                                 double base, double sigma_factor,
                                  std::vector<int>* indices) const {
+  const Eigen::Vector2d direction = end - start;
+  const double length_squared = direction.squaredNorm();
+  const Eigen::Vector2d low = start.cwiseMin(end), high = start.cwiseMax(end);
   for (const SizeClass& size_class : classes_) {
     const double max_sigma = size_class.max_sigma;
     const double radius_squared = base + sigma_factor * max_sigma * max_sigma;
     if (!(radius_squared >= 0.0)) continue;
     const double radius = std::sqrt(radius_squared);
-    const auto [col_first, col_last] = size_class.CellRange(point.x() - radius, point.x() + radius,
+    const auto [col_first, col_last] = size_class.CellRange(low.x() - radius, high.x() + radius,
                                                             size_class.origin_x, size_class.cols);
-    const auto [row_first, row_last] = size_class.CellRange(point.y() - radius, point.y() + radius,
+    const auto [row_first, row_last] = size_class.CellRange(low.y() - radius, high.y() + radius,
                                                             size_class.origin_y, size_class.rows);
     for (int row = row_first; row <= row_last; ++row) {
       // The cells of one grid row are contiguous in gaussians_.
       const int begin = size_class.cell_begin[row * size_class.cols + col_first];
-      const int end = size_class.cell_begin[row * size_class.cols + col_last + 1];
-      for (int i = begin; i < end; ++i) {
+      const int stop = size_class.cell_begin[row * size_class.cols + col_last + 1];
+      for (int i = begin; i < stop; ++i) {
         const ImageGaussian& g = gaussians_[i];
-        const double dx = g.x - point.x(), dy = g.y - point.y();
+        Eigen::Vector2d offset(g.x - start.x(), g.y - start.y());
+        if (length_squared > 0.0) {
+          // From the nearest point of the segment.
+          offset -= std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) * direction;
+        }
         const double sigma = g.sigma;
-        if (dx * dx + dy * dy <= base + sigma_factor * sigma * sigma) indices->push_back(i);
+        if (offset.squaredNorm() <= base + sigma_factor * sigma * sigma) indices->push_back(i);
       }
     }
   }
@@ -487,14 +495,20 @@ void ImageGaussians::CollectNear(const Eigen::Vector2d& point, double base, doub
 void ImageGaussians::FindWithin(const Eigen::Vector2d& point, double radius,
                                 std::vector<int>* indices) const {
   indices->clear();
-  if (radius >= 0.0) CollectNear(point, radius * radius, 0.0, indices);
+  if (radius >= 0.0) CollectNear(point, point, radius * radius, 0.0, indices);
 }
 
 void ImageGaussians::FindReaching(const Eigen::Vector2d& point, double sigma, double cutoff,
                                   std::vector<int>* indices) const {
+  FindReachingSegment(point, point, sigma, cutoff, indices);
+}
+
+void ImageGaussians::FindReachingSegment(const Eigen::Vector2d& start, const Eigen::Vector2d& end,
+                                         double sigma, double cutoff,
+                                         std::vector<int>* indices) const {
   indices->clear();
   const double cutoff_squared = cutoff * cutoff;
-  CollectNear(point, cutoff_squared * sigma * sigma, cutoff_squared, indices);
+  CollectNear(start, end, cutoff_squared * sigma * sigma, cutoff_squared, indices);
 }
 
 ImageGaussians BuildImageGaussians(const cv::Mat& image, const cv::Mat& mask,

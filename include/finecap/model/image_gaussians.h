@@ -122,6 +122,12 @@ class ImageGaussians {
   void FindReaching(const Eigen::Vector2d& point, double sigma, double cutoff,
                     std::vector<int>* indices) const;
 
+  // The same for a Gaussian anywhere on the segment [start, end]: the Gaussians i whose squared
+  // distance to the segment is at most cutoff^2 * (sigma^2 + sigma_i^2), in no particular order
+  // (the same for the same query). What a surface Gaussian can reach as it moves along its normal.
+  void FindReachingSegment(const Eigen::Vector2d& start, const Eigen::Vector2d& end, double sigma,
+                           double cutoff, std::vector<int>* indices) const;
+
  private:
   // The Gaussians with sigma in [2^k, 2^(k+1)) for one k, bucketed in a uniform grid whose cell
   // is about one such Gaussian's square, so a cell holds about one Gaussian.
@@ -148,9 +154,10 @@ class ImageGaussians {
   void AppendSizeClass(const std::vector<ImageGaussian>& all, const int* members, int count,
                        int exponent);
 
-  // Appends the Gaussians with |mean - point|^2 <= base + sigma_factor * sigma_i^2.
-  void CollectNear(const Eigen::Vector2d& point, double base, double sigma_factor,
-                   std::vector<int>* indices) const;
+  // Appends the Gaussians whose squared distance to the segment [start, end] (a point when they
+  // are equal) is at most base + sigma_factor * sigma_i^2.
+  void CollectNear(const Eigen::Vector2d& start, const Eigen::Vector2d& end, double base,
+                   double sigma_factor, std::vector<int>* indices) const;
 
   int width_ = 0;
   int height_ = 0;
