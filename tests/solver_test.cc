@@ -165,9 +165,13 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
   FrameEnergy& energy = scene.energy;
   const Eigen::VectorXd& k = scene.k;
   SimilarityTerm& term = energy.similarity();
-  // The full blocks read the residuals, the reduced blocks of one parameter their summaries.
-  term.PrepareResiduals(k, true);
-  term.PrepareBlockSummaries(k);
+  // Prepared as in a solve; the full blocks then need the residuals: the paper's term, whose
+  // blocks mix one parameter and several, has them from the callback too.
+  Eigen::VectorXd point = k;
+  double seconds = 0.0;
+  SharedEvaluationCallback callback(&term, &point, &seconds);
+  callback.PrepareForEvaluation(true, true);
+  if (similarity != "paper") term.PrepareResiduals(k, true);
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
     const SimilarityBlockCost full(term, b);
     const ReducedSimilarityBlockCost reduced(term, b);

@@ -29,7 +29,7 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool /*evaluate_jacobians*/,
   if (summaries_only_) {
     term_->PrepareBlockSummaries(*k_);
   } else {
-    term_->PrepareResiduals(*k_, true);
+    term_->SimilarityTerm::PrepareBlockSummaries(*k_);
   }
   prepared_ = *k_;
   *seconds_ += clock.Seconds();

@@ -16,10 +16,11 @@
 namespace finecap {
 
 // Calls SimilarityTerm::PrepareBlockSummaries when every block of the term has one parameter
-// (ReducedSimilarityBlockCost needs no more of them), else PrepareResiduals with Jacobians, at
-// every evaluation point that differs from the last one prepared. `k` is the vector whose
-// entries are the problem's parameter blocks: Ceres has written the point there when it calls.
-// Time spent is added to *seconds.
+// (ReducedSimilarityBlockCost needs no more of them), else its default implementation, which
+// prepares the residuals with Jacobians too (the paper's term mixes blocks of one parameter and
+// of several), at every evaluation point that differs from the last one prepared. `k` is the vector
+// whose entries are the problem's parameter blocks: Ceres has written the point there when it
+// calls. Time spent is added to *seconds.
 class SharedEvaluationCallback : public ceres::EvaluationCallback {
  public:
   SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k, double* seconds);

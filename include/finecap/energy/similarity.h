@@ -56,8 +56,9 @@ class SimilarityTerm {
   };
   // Computes the BlockSummary of every block of one parameter at `k` (blocks of several are left
   // out); BlockSummaryOf then reads them, from any number of threads, until the next call.
-  // BlockResiduals is not valid after it. By default from PrepareResiduals(k, true) and
-  // BlockResiduals; a term may compute them without storing every residual.
+  // BlockResiduals is not valid after it, but for this default implementation, which prepares
+  // the residuals with Jacobians and sums them (a term may compute its summaries without storing
+  // every residual).
   virtual void PrepareBlockSummaries(const Eigen::VectorXd& k);
   const BlockSummary& BlockSummaryOf(int block) const { return summaries_[block]; }
 
