@@ -60,16 +60,23 @@ std::vector<std::string> CameraNames() {
   return names;
 }
 
-// The whole frame: 8 images converted to HSV and cut into Gaussians, on range(0) threads.
+ImageGaussianOptions LeafSizeOptions(int min_leaf_size) {
+  ImageGaussianOptions options;
+  options.min_leaf_size = min_leaf_size;
+  return options;
+}
+
+// The whole frame: 8 images converted to HSV and cut into Gaussians, on range(0) threads, with
+// smallest leaves of range(1) pixels (1: finecap refine's default; 4: the paper's depth 8).
 void BM_BuildFrameImageGaussians(benchmark::State& state) {
   const std::vector<cv::Mat>& images = FrameImages();
   const std::vector<std::string> names = CameraNames();
+  const ImageGaussianOptions options = LeafSizeOptions(static_cast<int>(state.range(1)));
   const int previous_threads = omp_get_max_threads();
   omp_set_num_threads(static_cast<int>(state.range(0)));
   size_t leaves = 0;
   for (auto _ : state) {
-    const std::vector<ImageGaussians> frame =
-        BuildFrameImageGaussians(images, {}, ImageGaussianOptions(), names);
+    const std::vector<ImageGaussians> frame = BuildFrameImageGaussians(images, {}, options, names);
     leaves = 0;
     for (const ImageGaussians& gaussians : frame) leaves += gaussians.size();
     benchmark::DoNotOptimize(leaves);
@@ -80,23 +87,26 @@ void BM_BuildFrameImageGaussians(benchmark::State& state) {
       benchmark::Counter(double(kCameras) * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_BuildFrameImageGaussians)
-    ->Arg(1)
-    ->Arg(omp_get_max_threads())
+    ->ArgNames({"threads", "leaf"})
+    ->ArgsProduct({{1, omp_get_max_threads()}, {1, 4}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 const ColorSpace kSpaces[] = {ColorSpace::kHsv, ColorSpace::kNormalizedRgb, ColorSpace::kLab};
 
-// One image, one thread, by colour space; the conversion alone for comparison.
+// One image, one thread, by colour space and smallest leaf; the conversion alone for comparison.
 void BM_BuildImageGaussians(benchmark::State& state) {
-  ImageGaussianOptions options;
+  ImageGaussianOptions options = LeafSizeOptions(static_cast<int>(state.range(1)));
   options.color_space = kSpaces[state.range(0)];
   state.SetLabel(ColorSpaceName(options.color_space));
   for (auto _ : state) {
     benchmark::DoNotOptimize(BuildImageGaussians(FrameImages()[0], cv::Mat(), options, "cam0"));
   }
 }
-BENCHMARK(BM_BuildImageGaussians)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BuildImageGaussians)
+    ->ArgNames({"space", "leaf"})
+    ->ArgsProduct({{0, 1, 2}, {1, 4}})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_ConvertImage(benchmark::State& state) {
   const ColorSpace space = kSpaces[state.range(0)];

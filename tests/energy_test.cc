@@ -196,7 +196,7 @@ TEST(ConsensusSimilarityTest, IgnoresEachCamerasGainAndOffset) {
 }
 
 // The colour tables hold, at each node, the overlap-weighted colour and its slope that
-// ImageColorOfPairs computes directly, in every overlap form.
+// ImageColorOfPairs computes directly over the image Gaussians in reach, in every overlap form.
 TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
   for (const std::string form : {"printed", "exact", "patch"}) {
     EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
@@ -216,8 +216,9 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
         for (int node = 1; node + 1 < num_nodes; ++node) {
           const double k = -options.k_max + node * step;
           Eigen::Vector3d direct_slope, tabulated_slope;
-          const Eigen::Vector3d direct = ImageColorOfPairs(view, energy.surface(), row, k,
-                                                           options.overlap, own, &direct_slope);
+          const Eigen::Vector3d direct =
+              ImageColorOfPairs(view, energy.surface(), row, k, options.overlap, own, &direct_slope,
+                                options.reach_sigmas);
           const Eigen::Vector3d tabulated = consensus.Interpolate(c, row, k, &tabulated_slope);
           EXPECT_LT((tabulated - direct).norm(), 1e-6 * (1.0 + direct.norm())) << form;
           EXPECT_LT((tabulated_slope - direct_slope).norm(), 1e-5 * (1.0 + direct_slope.norm()))

@@ -8,6 +8,7 @@
 #include "finecap/util/error.h"
 #include "model/image_color.h"
 #include "model/surface_projection.h"
+#include "util/fast_exp.h"
 
 namespace finecap {
 namespace {
@@ -99,11 +100,12 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
 ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
                                          const std::vector<EnergyView>& views,
                                          const std::vector<std::vector<int>>& one_rings,
-                                         OverlapForm form, double k_max,
+                                         OverlapForm form, double k_max, double reach_sigmas,
                                          const ConsensusOptions& options)
     : surface_(surface),
       views_(views),
       form_(form),
+      reach_sigmas_(reach_sigmas),
       options_(options),
       scale_(1.0 / std::sqrt(static_cast<double>(std::max<size_t>(views.size(), 1)))) {
   options_.Check();
@@ -158,7 +160,7 @@ void ConsensusSimilarity::BuildTables(double k_max) {
     table_[c].resize(long(num_rows) * num_nodes_);
 #pragma omp parallel
     {
-      std::vector<PairedImageGaussian> paired;
+      RowImageGaussians paired;
 #pragma omp for schedule(dynamic, 16)
       for (int row = 0; row < num_rows; ++row) {
         TabulateRow(views_[c], row, &paired, &table_[c][long(row) * num_nodes_]);
@@ -167,40 +169,105 @@ void ConsensusSimilarity::BuildTables(double k_max) {
   }
 }
 
-void ConsensusSimilarity::TabulateRow(const EnergyView& view, int row,
-                                      std::vector<PairedImageGaussian>* paired,
-                                      TableNode* nodes) const {
+void ConsensusSimilarity::RowImageGaussians::Assign(const EnergyView& view, int row,
+                                                    OverlapForm form) {
   const CameraPairs& pairs = view.pairs;
-  const int s = pairs.surface_ids[row];
-  paired->clear();
-  for (int p = pairs.begin[row]; p < pairs.begin[row + 1]; ++p) {
-    const ImageGaussian& g = (*view.image)[pairs.image_ids[p]];
-    const double variance = double(g.sigma) * g.sigma;
-    paired->push_back({Eigen::Vector2d(g.x, g.y), variance, ImageVarianceFactor(form_) * variance,
-                       g.Color().cast<double>()});
+  const int n = pairs.begin[row + 1] - pairs.begin[row];
+  for (std::vector<float>* values :
+       {&x, &y, &variance, &scaled_variance, &color[0], &color[1], &color[2]}) {
+    values->resize(n);
   }
-  const double inverse_divisor = 1.0 / ExponentDivisor(form_);
+  for (int i = 0; i < n; ++i) {
+    const ImageGaussian& g = (*view.image)[pairs.image_ids[pairs.begin[row] + i]];
+    x[i] = g.x;
+    y[i] = g.y;
+    variance[i] = g.sigma * g.sigma;
+    scaled_variance[i] = static_cast<float>(ImageVarianceFactor(form)) * variance[i];
+    for (int channel = 0; channel < 3; ++channel) color[channel][i] = g.color[channel];
+  }
+}
+
+namespace {
+
+// Over the image Gaussians of a row: the sums of their overlaps E with a projected surface
+// Gaussian, of dE/dk, and of both times their colours (the terms of ColorAccumulator).
+struct OverlapSums {
+  float overlap = 0.0f, doverlap = 0.0f;
+  float weighted[3] = {0.0f, 0.0f, 0.0f};
+  float dweighted[3] = {0.0f, 0.0f, 0.0f};
+};
+
+// GaussianOverlap and its k-derivative for every image Gaussian of `row` within `reach_sigmas`
+// combined standard deviations (as ImageColorAround counts them), summed. With what depends only
+// on the projected Gaussian taken out of the loop, and in single precision (the tables hold single
+// precision), so that the loop runs over several image Gaussians at a time: eight with AVX2, where
+// the processor has it (chosen when the program loads; the build itself assumes only SSE2).
+__attribute__((target_clones("avx2", "default"))) OverlapSums SumOverlaps(
+    const ConsensusSimilarity::RowImageGaussians& row, const ProjectedGaussian& projected,
+    double exponent_divisor, double reach_sigmas) {
+  const int n = static_cast<int>(row.x.size());
+  const float* x = row.x.data();
+  const float* y = row.y.data();
+  const float* variance = row.variance.data();
+  const float* scaled_variance = row.scaled_variance.data();
+  const float* red = row.color[0].data();
+  const float* green = row.color[1].data();
+  const float* blue = row.color[2].data();
+  const float inverse_divisor = static_cast<float>(1.0 / exponent_divisor);
+  const float reach2 = static_cast<float>(reach_sigmas * reach_sigmas);
+  const float mean_x = static_cast<float>(projected.mean.x());
+  const float mean_y = static_cast<float>(projected.mean.y());
+  const float dmean_x = static_cast<float>(projected.dmean_dk.x());
+  const float dmean_y = static_cast<float>(projected.dmean_dk.y());
+  const float var_s = static_cast<float>(projected.sigma * projected.sigma);
+  const float two_pi_var_s = static_cast<float>(2.0 * M_PI) * var_s;
+  const float inverse_var_s = 1.0f / var_s;
+  const float dvar_dk = static_cast<float>(2.0 * projected.sigma * projected.dsigma_dk);
+  float overlap_sum = 0.0f, doverlap_sum = 0.0f;
+  float red_sum = 0.0f, green_sum = 0.0f, blue_sum = 0.0f;
+  float dred_sum = 0.0f, dgreen_sum = 0.0f, dblue_sum = 0.0f;
+#pragma omp simd reduction(+ : overlap_sum, doverlap_sum, red_sum, green_sum, blue_sum, dred_sum, \
+                               dgreen_sum, dblue_sum)
+  for (int i = 0; i < n; ++i) {
+    const float dx = x[i] - mean_x, dy = y[i] - mean_y;
+    const float d2 = dx * dx + dy * dy;
+    const float in_reach = d2 <= reach2 * (var_s + variance[i]) ? 1.0f : 0.0f;
+    const float inverse_sum = 1.0f / (var_s + scaled_variance[i]);
+    const float spread = d2 * inverse_divisor * inverse_sum;
+    const float overlap =
+        in_reach * two_pi_var_s * variance[i] * inverse_sum * internal::FastExpNonPositive(-spread);
+    const float dlog_dk = (inverse_var_s - inverse_sum + spread * inverse_sum) * dvar_dk +
+                          2.0f * (dx * dmean_x + dy * dmean_y) * inverse_divisor * inverse_sum;
+    const float doverlap = overlap * dlog_dk;
+    overlap_sum += overlap;
+    doverlap_sum += doverlap;
+    red_sum += overlap * red[i];
+    green_sum += overlap * green[i];
+    blue_sum += overlap * blue[i];
+    dred_sum += doverlap * red[i];
+    dgreen_sum += doverlap * green[i];
+    dblue_sum += doverlap * blue[i];
+  }
+  return {
+      overlap_sum, doverlap_sum, {red_sum, green_sum, blue_sum}, {dred_sum, dgreen_sum, dblue_sum}};
+}
+
+}  // namespace
+
+void ConsensusSimilarity::TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
+                                      TableNode* nodes) const {
+  const int s = view.pairs.surface_ids[row];
+  paired->Assign(view, row, form_);
   const Eigen::Vector3d fallback = surface_.colors[s].cast<double>();
   for (int node = 0; node < num_nodes_; ++node) {
     const ProjectedGaussian projected =
         ProjectSurfaceGaussian(view.camera, surface_.base.col(s), surface_.normals.col(s),
                                node_k0_ + node * node_step_, surface_.sigma_hat);
-    // GaussianOverlap and its k-derivative, with what depends only on the node taken out of the
-    // loop over the row's image Gaussians and one division per pair.
-    const double var_s = projected.sigma * projected.sigma;
-    const double inverse_var_s = 1.0 / var_s;
-    const double dvar_dk = 2.0 * projected.sigma * projected.dsigma_dk;
+    const OverlapSums sums = SumOverlaps(*paired, projected, ExponentDivisor(form_), reach_sigmas_);
     internal::ColorAccumulator accumulator(fallback);
-    for (const PairedImageGaussian& g : *paired) {
-      const double inverse_sum = 1.0 / (var_s + g.scaled_variance);
-      const Eigen::Vector2d d = g.mean - projected.mean;
-      const double d2 = d.squaredNorm();
-      const double spread = d2 * inverse_divisor * inverse_sum;
-      const double overlap = 2.0 * M_PI * var_s * g.variance * inverse_sum * std::exp(-spread);
-      const double dlog_dvar = inverse_var_s - inverse_sum + spread * inverse_sum;
-      const double dlog_dmean = 2.0 * d.dot(projected.dmean_dk) * inverse_divisor * inverse_sum;
-      accumulator.AddOverlap(overlap, overlap * (dlog_dvar * dvar_dk + dlog_dmean), g.color);
-    }
+    accumulator.AddSums(sums.overlap, sums.doverlap,
+                        Eigen::Vector3d(sums.weighted[0], sums.weighted[1], sums.weighted[2]),
+                        Eigen::Vector3d(sums.dweighted[0], sums.dweighted[1], sums.dweighted[2]));
     nodes[node].color = accumulator.Mean().cast<float>();
     nodes[node].slope = (node_step_ * accumulator.MeanDerivative()).cast<float>();
   }

@@ -29,10 +29,12 @@
 // regulariser, as for surface_color.
 //
 // Speed: a member's colour is needed at the k of every patch it belongs to (about seven), so each
-// p_jc(k) is tabulated once per frame, with its derivative, at displacements sigma_hat / 3 apart
+// p_jc(k) is tabulated once per frame, with its derivative, at displacements sigma_hat / 2 apart
 // over [-k_max, k_max], and read between them by cubic Hermite interpolation (exact at the nodes,
 // C1 between them). The energy the solvers see is the interpolated one, and its Jacobians are
-// those of the interpolant, exactly.
+// those of the interpolant, exactly. At a node, only the image Gaussians within `reach_sigmas`
+// combined standard deviations of the projected Gaussian there count (as ImageColorAround counts
+// them): the row's pair list covers its whole path over [-k_max, k_max].
 //
 // Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
 // patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
@@ -58,7 +60,7 @@ class ConsensusSimilarity : public SimilarityTerm {
   // must have been built without colour weights; `surface` and `views` must outlive this object.
   ConsensusSimilarity(const SurfaceGaussians& surface, const std::vector<EnergyView>& views,
                       const std::vector<std::vector<int>>& one_rings, OverlapForm form,
-                      double k_max, const ConsensusOptions& options);
+                      double k_max, double reach_sigmas, const ConsensusOptions& options);
 
   double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
@@ -78,12 +80,24 @@ class ConsensusSimilarity : public SimilarityTerm {
   void SetPatchShape(const Eigen::VectorXd& shape);
 
   // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk (when not null). At
-  // the tables' nodes it is ImageColorOfPairs (surface_color_similarity.h) in single precision;
-  // between them a cubic Hermite interpolation.
+  // the tables' nodes it is ImageColorOfPairs (surface_color_similarity.h) over the row's image
+  // Gaussians within reach there, in single precision; between them a cubic Hermite
+  // interpolation.
   Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
 
   // The weight w_s of each block, per channel (the patch's contrast at the input surface).
   const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
+
+  // The image Gaussians of one pair-list row as the tables' loop reads them: one array per
+  // quantity, in single precision, so that the loop runs over several of them at a time.
+  struct RowImageGaussians {
+    std::vector<float> x, y;
+    std::vector<float> variance;         // sigma_i^2.
+    std::vector<float> scaled_variance;  // Its share of S: ImageVarianceFactor(form) sigma_i^2.
+    std::vector<float> color[3];         // Per channel.
+
+    void Assign(const EnergyView& view, int row, OverlapForm form);
+  };
 
  private:
   // A node's colour and its slope (dcolour/dk times node_step_, the Hermite tangent) side by
@@ -93,19 +107,11 @@ class ConsensusSimilarity : public SimilarityTerm {
     Eigen::Vector3f color;
     Eigen::Vector3f slope;
   };
-  // An image Gaussian of a pair, in the form the tables' overlaps read it.
-  struct PairedImageGaussian {
-    Eigen::Vector2d mean;
-    double variance;         // sigma_i^2.
-    double scaled_variance;  // Its share of S: ImageVarianceFactor(form) sigma_i^2.
-    Eigen::Vector3d color;
-  };
-
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
   // The nodes of one row of `view`'s pair list: ImageColorOfPairs at each node, with the row's
   // image Gaussians gathered once (into `paired`) instead of once per node.
-  void TabulateRow(const EnergyView& view, int row, std::vector<PairedImageGaussian>* paired,
+  void TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
                    TableNode* nodes) const;
   // Colours of every row of every camera's pair list at one k, [c][row].
   using RowColors = std::vector<std::vector<Eigen::Vector3d>>;
@@ -125,6 +131,7 @@ class ConsensusSimilarity : public SimilarityTerm {
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
   OverlapForm form_;
+  double reach_sigmas_;
   ConsensusOptions options_;
   double scale_;  // 1 / sqrt(n_c).
 

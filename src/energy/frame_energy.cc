@@ -69,7 +69,7 @@ std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
   if (options.similarity == SimilarityType::kConsensus) {
     return std::make_unique<ConsensusSimilarity>(
         surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form,
-        options.k_max, options.consensus);
+        options.k_max, options.reach_sigmas, options.consensus);
   }
   return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
 }

@@ -53,8 +53,9 @@ void PaperSimilarity::ComputeOverlaps(int camera, const Eigen::VectorXd& k, bool
       double derivative = 0.0;
       const double overlap = GaussianOverlap(form_, projected, Eigen::Vector2d(g.x, g.y), g.sigma,
                                              with_derivatives ? &derivative : nullptr);
-      overlaps->overlap[p] = pairs.color_weights[p] * overlap;
-      if (with_derivatives) overlaps->derivative[p] = pairs.color_weights[p] * derivative;
+      const double weight = pairs.color_weight(p);
+      overlaps->overlap[p] = weight * overlap;
+      if (with_derivatives) overlaps->derivative[p] = weight * derivative;
       overlaps->sums[pairs.image_ids[p]] += overlaps->overlap[p];
     }
   }

@@ -34,14 +34,19 @@ SurfaceColorSimilarity::SurfaceColorSimilarity(const SurfaceGaussians& surface,
 
 Eigen::Vector3d ImageColorOfPairs(const EnergyView& view, const SurfaceGaussians& surface, int row,
                                   double k, OverlapForm form, const Eigen::Vector3d& fallback,
-                                  Eigen::Vector3d* derivative) {
+                                  Eigen::Vector3d* derivative, double reach_sigmas) {
   const CameraPairs& pairs = view.pairs;
   const int s = pairs.surface_ids[row];
   const ProjectedGaussian projected = ProjectSurfaceGaussian(
       view.camera, surface.base.col(s), surface.normals.col(s), k, surface.sigma_hat);
   ColorAccumulator accumulator(fallback);
   for (int p = pairs.begin[row]; p < pairs.begin[row + 1]; ++p) {
-    accumulator.Add(form, projected, (*view.image)[pairs.image_ids[p]], derivative != nullptr);
+    const ImageGaussian& g = (*view.image)[pairs.image_ids[p]];
+    const double reach2 = reach_sigmas * reach_sigmas *
+                          (projected.sigma * projected.sigma + double(g.sigma) * g.sigma);
+    const double d2 = (Eigen::Vector2d(g.x, g.y) - projected.mean).squaredNorm();
+    if (reach_sigmas > 0.0 && d2 > reach2) continue;
+    accumulator.Add(form, projected, g, derivative != nullptr);
   }
   if (derivative != nullptr) *derivative = accumulator.MeanDerivative();
   return accumulator.Mean();

@@ -31,11 +31,12 @@
 namespace finecap {
 
 // p_sc at displacement k of the surface Gaussian in row `row` of `view`'s pair list, over the
-// pairs of that row, and, when `derivative` is not null, dp_sc/dk. Where no image Gaussian is in
-// reach the colour tends to `fallback`.
+// pairs of that row (with `reach_sigmas` > 0, over those within that many combined standard
+// deviations of it at k), and, when `derivative` is not null, dp_sc/dk. Where no image Gaussian
+// is in reach the colour tends to `fallback`.
 Eigen::Vector3d ImageColorOfPairs(const EnergyView& view, const SurfaceGaussians& surface, int row,
                                   double k, OverlapForm form, const Eigen::Vector3d& fallback,
-                                  Eigen::Vector3d* derivative);
+                                  Eigen::Vector3d* derivative, double reach_sigmas = 0.0);
 
 class SurfaceColorSimilarity : public SimilarityTerm {
  public:

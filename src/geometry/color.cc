@@ -73,18 +73,12 @@ Eigen::Vector3f HsvCone(int b, int g, int r, const HueTable& table) {
                          value);
 }
 
-cv::Mat ConvertToHsvCone(const cv::Mat& bgr) {
+void ConvertToHsvCone(const cv::Vec3b* bgr, int count, cv::Vec3f* out) {
   const HueTable& table = GetHueTable();
-  cv::Mat out(bgr.size(), CV_32FC3);
-  for (int y = 0; y < bgr.rows; ++y) {
-    const cv::Vec3b* in_row = bgr.ptr<cv::Vec3b>(y);
-    cv::Vec3f* out_row = out.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < bgr.cols; ++x) {
-      const Eigen::Vector3f c = HsvCone(in_row[x][0], in_row[x][1], in_row[x][2], table);
-      out_row[x] = cv::Vec3f(c.x(), c.y(), c.z());
-    }
+  for (int x = 0; x < count; ++x) {
+    const Eigen::Vector3f c = HsvCone(bgr[x][0], bgr[x][1], bgr[x][2], table);
+    out[x] = cv::Vec3f(c.x(), c.y(), c.z());
   }
-  return out;
 }
 
 cv::Mat ConvertToNormalizedRgb(const cv::Mat& bgr) {
@@ -94,16 +88,19 @@ cv::Mat ConvertToNormalizedRgb(const cv::Mat& bgr) {
   return out;
 }
 
-cv::Mat ConvertToChromaticity(const cv::Mat& bgr) {
+void ConvertToChromaticity(const cv::Vec3b* bgr, int count, cv::Vec3f* out) {
+  for (int x = 0; x < count; ++x) {
+    const float b = bgr[x][0], g = bgr[x][1], r = bgr[x][2];
+    const float scale = 1.0f / (r + g + b + kChromaticityDarkLevel);
+    out[x] = cv::Vec3f(r * scale, g * scale, b * scale);
+  }
+}
+
+// An image converted row by row with ConvertPixels: the same values as any part converted alone.
+cv::Mat ConvertRows(const cv::Mat& bgr, ColorSpace space) {
   cv::Mat out(bgr.size(), CV_32FC3);
   for (int y = 0; y < bgr.rows; ++y) {
-    const cv::Vec3b* in_row = bgr.ptr<cv::Vec3b>(y);
-    cv::Vec3f* out_row = out.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < bgr.cols; ++x) {
-      const float b = in_row[x][0], g = in_row[x][1], r = in_row[x][2];
-      const float scale = 1.0f / (r + g + b + kChromaticityDarkLevel);
-      out_row[x] = cv::Vec3f(r * scale, g * scale, b * scale);
-    }
+    ConvertPixels(bgr.ptr<cv::Vec3b>(y), bgr.cols, space, out.ptr<cv::Vec3f>(y));
   }
   return out;
 }
@@ -120,13 +117,12 @@ cv::Mat ConvertToLab(const cv::Mat& bgr) {
 cv::Mat ConvertUnchecked(const cv::Mat& bgr, ColorSpace space) {
   switch (space) {
     case ColorSpace::kHsv:
-      return ConvertToHsvCone(bgr);
+    case ColorSpace::kChromaticity:
+      return ConvertRows(bgr, space);
     case ColorSpace::kNormalizedRgb:
       return ConvertToNormalizedRgb(bgr);
     case ColorSpace::kLab:
       return ConvertToLab(bgr);
-    case ColorSpace::kChromaticity:
-      return ConvertToChromaticity(bgr);
   }
   throw Error("", "unknown colour space");
 }
@@ -156,6 +152,24 @@ Eigen::Vector3f ConvertColor(const cv::Vec3b& bgr, ColorSpace space) {
   const cv::Mat converted = ConvertUnchecked(cv::Mat(1, 1, CV_8UC3, cv::Scalar(bgr)), space);
   const cv::Vec3f c = converted.at<cv::Vec3f>(0, 0);
   return Eigen::Vector3f(c[0], c[1], c[2]);
+}
+
+bool ConvertsPixelByPixel(ColorSpace space) {
+  return space == ColorSpace::kHsv || space == ColorSpace::kChromaticity;
+}
+
+void ConvertPixels(const cv::Vec3b* bgr, int count, ColorSpace space, cv::Vec3f* out) {
+  switch (space) {
+    case ColorSpace::kHsv:
+      return ConvertToHsvCone(bgr, count, out);
+    case ColorSpace::kChromaticity:
+      return ConvertToChromaticity(bgr, count, out);
+    case ColorSpace::kNormalizedRgb:
+    case ColorSpace::kLab:
+      break;
+  }
+  throw Error("ConvertPixels", "colour space '" + ColorSpaceName(space) +
+                                   "' is converted by whole images only (ConvertImage)");
 }
 
 cv::Mat ConvertImage(const cv::Mat& bgr, ColorSpace space, const std::string& where) {

@@ -48,17 +48,20 @@ void ReachableImageGaussians(const Camera& camera, const ImageGaussians& image,
   std::sort(reached->begin(), reached->end());
 }
 
-// The pairs of surface Gaussian s: image Gaussians in reach with a non-zero colour weight.
+// The pairs of surface Gaussian s: image Gaussians in reach with a non-zero colour weight (and
+// their weights), or, without colour weights, every image Gaussian in reach.
 void PairsOf(const Camera& camera, const ImageGaussians& image, const SurfaceGaussians& surface,
              int s, const PairOptions& options, std::vector<int>* candidates,
              std::vector<int>* reached, std::vector<int>* ids, std::vector<float>* weights) {
   ReachableImageGaussians(camera, image, surface, s, options, candidates, reached);
+  if (options.color_cutoff <= 0.0) {
+    ids->insert(ids->end(), reached->begin(), reached->end());
+    return;
+  }
   for (int i : *reached) {
     const double weight =
-        options.color_cutoff > 0.0
-            ? Wendland(ColorDistance(image[i].Color(), surface.colors[s], surface.color_space),
-                       options.color_cutoff)
-            : 1.0;
+        Wendland(ColorDistance(image[i].Color(), surface.colors[s], surface.color_space),
+                 options.color_cutoff);
     if (weight <= 0.0) continue;
     ids->push_back(i);
     weights->push_back(static_cast<float>(weight));
@@ -118,10 +121,14 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
   pairs.begin.assign(n + 1, 0);
   for (int j = 0; j < n; ++j) pairs.begin[j + 1] = pairs.begin[j] + static_cast<int>(ids[j].size());
   pairs.image_ids.reserve(pairs.begin[n]);
-  pairs.color_weights.reserve(pairs.begin[n]);
   for (int j = 0; j < n; ++j) {
     pairs.image_ids.insert(pairs.image_ids.end(), ids[j].begin(), ids[j].end());
-    pairs.color_weights.insert(pairs.color_weights.end(), weights[j].begin(), weights[j].end());
+  }
+  if (options.color_cutoff > 0.0) {
+    pairs.color_weights.reserve(pairs.begin[n]);
+    for (int j = 0; j < n; ++j) {
+      pairs.color_weights.insert(pairs.color_weights.end(), weights[j].begin(), weights[j].end());
+    }
   }
   return pairs;
 }

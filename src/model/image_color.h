@@ -43,6 +43,15 @@ class ColorAccumulator {
     dweight_ += doverlap;
     dweighted_ += doverlap * color;
   }
+  // The same for sums over several image Gaussians: of the overlaps, their k-derivatives, and
+  // both times the colours.
+  void AddSums(double overlaps, double doverlaps, const Eigen::Vector3d& weighted_colors,
+               const Eigen::Vector3d& dweighted_colors) {
+    weight_ += overlaps;
+    weighted_ += weighted_colors;
+    dweight_ += doverlaps;
+    dweighted_ += dweighted_colors;
+  }
   Eigen::Vector3d Mean() const { return weighted_ / weight_; }
   Eigen::Vector3d MeanDerivative() const { return (dweighted_ - Mean() * dweight_) / weight_; }
 

@@ -17,11 +17,25 @@ namespace {
 constexpr double kSpreadSquaredTolerance = 1e-13;
 constexpr int kMaxRootSide = ImageGaussianOptions::kMaxRootSide;
 
+// The smallest squares that the moment pyramid stores have at least this side, pixels; the levels
+// below are summed again from the pixels of a stored square when the walker splits it. At 1 px
+// leaves this keeps 1/16 of a node per pixel instead of 4/3, and re-reads only the pixels of the
+// squares that split that far.
+constexpr int kMinStoredSide = 4;
+
 // Sums over the foreground pixels of one quad-tree square.
 struct Moments {
   double sum[3] = {0.0, 0.0, 0.0};  // Of the embedded colours.
   double sum_squared = 0.0;         // Of the squared norms of the embedded colours.
   int64_t count = 0;                // Of the pixels.
+
+  void AddPixel(const cv::Vec3f& c) {
+    sum[0] += c[0];
+    sum[1] += c[1];
+    sum[2] += c[2];
+    sum_squared += double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2];
+    ++count;
+  }
 
   void Add(const Moments& other) {
     for (int c = 0; c < 3; ++c) sum[c] += other.sum[c];
@@ -37,14 +51,18 @@ struct Moments {
   }
 };
 
-// One level of the moment pyramid: a grid of squares of equal side.
+// One level of a moment pyramid: a grid of squares of equal side.
 struct MomentGrid {
   int cols = 0;
   int rows = 0;
   std::vector<Moments> cells;
 
-  MomentGrid(int num_cols, int num_rows)
-      : cols(num_cols), rows(num_rows), cells(size_t(num_cols) * num_rows) {}
+  // Zeroes the grid in the memory it already holds, when it is large enough.
+  void Reset(int num_cols, int num_rows) {
+    cols = num_cols;
+    rows = num_rows;
+    cells.assign(size_t(num_cols) * num_rows, Moments());
+  }
   bool Contains(int col, int row) const { return col < cols && row < rows; }
   Moments& at(int col, int row) { return cells[size_t(row) * cols + col]; }
   const Moments& at(int col, int row) const { return cells[size_t(row) * cols + col]; }
@@ -52,91 +70,229 @@ struct MomentGrid {
 
 int CeilDiv(int a, int b) { return (a + b - 1) / b; }
 
-// Level 0: the moments of the squares of side `side` tiling the image from (0, 0).
-MomentGrid SmallestSquareMoments(const cv::Mat& colors, const cv::Mat& mask, int side) {
-  MomentGrid grid(CeilDiv(colors.cols, side), CeilDiv(colors.rows, side));
-  for (int y = 0; y < colors.rows; ++y) {
-    const cv::Vec3f* color_row = colors.ptr<cv::Vec3f>(y);
-    const uint8_t* mask_row = mask.empty() ? nullptr : mask.ptr<uint8_t>(y);
-    Moments* cell_row = &grid.at(0, y / side);
-    for (int col = 0; col < grid.cols; ++col) {
+// The embedded colours of an image a run of pixels at a time: rows of an image given or
+// converted whole, or, in a space converted pixel by pixel, runs of the 8-bit image converted
+// when asked (no full-image float copy; the pixels of split squares are converted twice).
+class ColorRuns {
+ public:
+  ColorRuns(const cv::Mat& image, ColorSpace space, const std::string& where) : space_(space) {
+    if (image.type() == CV_32FC3) {
+      colors_ = image;
+    } else if (ConvertsPixelByPixel(space)) {
+      bgr_ = image;
+    } else {
+      colors_ = ConvertImage(image, space, where);
+    }
+  }
+
+  // The colours of the pixels [x, x + count) of row y; `scratch` has room for `count` colours.
+  const cv::Vec3f* Run(int y, int x, int count, cv::Vec3f* scratch) const {
+    if (!colors_.empty()) return colors_.ptr<cv::Vec3f>(y) + x;
+    ConvertPixels(bgr_.ptr<cv::Vec3b>(y) + x, count, space_, scratch);
+    return scratch;
+  }
+
+ private:
+  ColorSpace space_;
+  cv::Mat colors_;
+  cv::Mat bgr_;
+};
+
+// Buffers of one thread's builds, kept from image to image so that their memory is faulted in
+// once rather than for every image of every frame.
+struct BuildBuffers {
+  std::vector<MomentGrid> stored;  // The pyramid's levels from the first stored one up.
+  std::vector<MomentGrid> band;    // Levels 0 .. first stored, over one row of stored squares.
+  std::vector<MomentGrid> block;   // Levels below the first stored, over one stored square.
+  std::vector<cv::Vec3f> run;      // Colours of one run of pixels.
+};
+
+BuildBuffers& ThreadBuildBuffers() {
+  thread_local BuildBuffers buffers;
+  return buffers;
+}
+
+// The pixels of `area`, whose corner lies on the grid of squares of side `side`.
+struct PixelArea {
+  const ColorRuns& colors;
+  const cv::Mat& mask;
+  cv::Rect rect;
+};
+
+// Level 0 over `area`: the sums of its squares of side `side`, each over its pixels row by row.
+void SmallestSquareMoments(const PixelArea& area, int side, std::vector<cv::Vec3f>* run,
+                           MomentGrid* grid) {
+  const cv::Rect& rect = area.rect;
+  grid->Reset(CeilDiv(rect.width, side), CeilDiv(rect.height, side));
+  run->resize(std::max<size_t>(run->size(), rect.width));
+  for (int dy = 0; dy < rect.height; ++dy) {
+    const int y = rect.y + dy;
+    const cv::Vec3f* color_row = area.colors.Run(y, rect.x, rect.width, run->data());
+    const uint8_t* mask_row = area.mask.empty() ? nullptr : area.mask.ptr<uint8_t>(y) + rect.x;
+    Moments* cell_row = &grid->at(0, dy / side);
+    for (int col = 0; col < grid->cols; ++col) {
       Moments& cell = cell_row[col];
-      const int x_end = std::min(colors.cols, (col + 1) * side);
+      const int x_end = std::min(rect.width, (col + 1) * side);
       for (int x = col * side; x < x_end; ++x) {
-        if (mask_row != nullptr && mask_row[x] == 0) continue;
-        const cv::Vec3f& c = color_row[x];
-        cell.sum[0] += c[0];
-        cell.sum[1] += c[1];
-        cell.sum[2] += c[2];
-        cell.sum_squared += double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2];
-        ++cell.count;
+        if (mask_row == nullptr || mask_row[x] != 0) cell.AddPixel(color_row[x]);
       }
     }
   }
-  return grid;
 }
 
-MomentGrid CoarserMoments(const MomentGrid& fine) {
-  MomentGrid coarse(CeilDiv(fine.cols, 2), CeilDiv(fine.rows, 2));
-  for (int row = 0; row < fine.rows; ++row) {
-    for (int col = 0; col < fine.cols; ++col) coarse.at(col / 2, row / 2).Add(fine.at(col, row));
+// Level 1 over `area` straight from its pixels when the smallest squares are single pixels: a
+// pixel's level-0 sums are its own values, so adding the pixels in the order CoarserMoments adds
+// their squares gives level 1 to the bit, without writing level 0.
+void PixelPairMoments(const PixelArea& area, std::vector<cv::Vec3f>* run, MomentGrid* grid) {
+  const cv::Rect& rect = area.rect;
+  grid->Reset(CeilDiv(rect.width, 2), CeilDiv(rect.height, 2));
+  run->resize(std::max<size_t>(run->size(), rect.width));
+  for (int dy = 0; dy < rect.height; ++dy) {
+    const int y = rect.y + dy;
+    const cv::Vec3f* color_row = area.colors.Run(y, rect.x, rect.width, run->data());
+    const uint8_t* mask_row = area.mask.empty() ? nullptr : area.mask.ptr<uint8_t>(y) + rect.x;
+    Moments* cell_row = &grid->at(0, dy / 2);
+    for (int x = 0; x < rect.width; ++x) {
+      if (mask_row == nullptr || mask_row[x] != 0) cell_row[x / 2].AddPixel(color_row[x]);
+    }
   }
-  return coarse;
 }
+
+// The level above `fine`: each square the sum of its quarters, top-left, top-right, bottom-left,
+// bottom-right. This order, with the row-by-row order of level 0, fixes every sum to the bit.
+void CoarserMoments(const MomentGrid& fine, MomentGrid* coarse) {
+  coarse->Reset(CeilDiv(fine.cols, 2), CeilDiv(fine.rows, 2));
+  for (int row = 0; row < fine.rows; ++row) {
+    for (int col = 0; col < fine.cols; ++col) coarse->at(col / 2, row / 2).Add(fine.at(col, row));
+  }
+}
+
+// Levels bottom .. top of the pyramid over `area`, into (*levels)[bottom .. top]; bottom is 0, or
+// 1 when the smallest squares are single pixels.
+void BuildPyramid(const PixelArea& area, int min_side, int bottom, int top,
+                  std::vector<cv::Vec3f>* run, std::vector<MomentGrid>* levels) {
+  if (static_cast<int>(levels->size()) < top + 1) levels->resize(top + 1);
+  if (bottom == 0) {
+    SmallestSquareMoments(area, min_side, run, &(*levels)[0]);
+  } else {
+    PixelPairMoments(area, run, &(*levels)[1]);
+  }
+  for (int level = bottom + 1; level <= top; ++level) {
+    CoarserMoments((*levels)[level - 1], &(*levels)[level]);
+  }
+}
+
+// The pyramid's levels first .. top over the whole image, into (*buffers).stored[0 .. top -
+// first]. Level `first` is summed one row of its squares at a time, through the levels below it
+// over that band of rows only, so those levels never exist for the whole image.
+void BuildStoredLevels(const ColorRuns& colors, const cv::Mat& mask, const cv::Size& size,
+                       int min_side, int first, int top, BuildBuffers* buffers) {
+  std::vector<MomentGrid>& stored = buffers->stored;
+  if (static_cast<int>(stored.size()) < top - first + 1) stored.resize(top - first + 1);
+  const int band_side = min_side << first;
+  stored[0].Reset(CeilDiv(size.width, band_side), CeilDiv(size.height, band_side));
+  for (int row = 0; row < stored[0].rows; ++row) {
+    const int y = row * band_side;
+    const PixelArea band{colors, mask,
+                         cv::Rect(0, y, size.width, std::min(band_side, size.height - y))};
+    BuildPyramid(band, min_side, (min_side == 1 && first >= 1) ? 1 : 0, first, &buffers->run,
+                 &buffers->band);
+    const std::vector<Moments>& band_cells = buffers->band[first].cells;
+    std::copy(band_cells.begin(), band_cells.end(), &stored[0].at(0, row));
+  }
+  for (int level = 1; level <= top - first; ++level)
+    CoarserMoments(stored[level - 1], &stored[level]);
+}
+
+// Levels [first, first + grids.size()) of a pyramid whose squares tile the pixels from `origin`.
+struct PyramidView {
+  const std::vector<MomentGrid>& grids;
+  int first;
+  cv::Point origin;
+
+  const MomentGrid& Level(int level) const { return grids[level - first]; }
+};
 
 // Walks the quad-tree top-down over the moment pyramid, emitting the leaves.
 class QuadTreeWalker {
  public:
-  QuadTreeWalker(const std::vector<MomentGrid>& pyramid, const ImageGaussianOptions& options,
+  QuadTreeWalker(const ColorRuns& colors, const cv::Mat& mask, const cv::Size& size,
+                 const ImageGaussianOptions& options, BuildBuffers* buffers,
                  std::vector<ImageGaussian>* leaves)
-      : pyramid_(pyramid),
+      : colors_(colors),
+        mask_(mask),
+        size_(size),
         min_side_(options.min_leaf_size),
         max_spread_squared_(options.split_threshold * options.split_threshold +
                             kSpreadSquaredTolerance),
+        buffers_(*buffers),
         leaves_(leaves) {}
 
-  void WalkAllRoots() {
-    const int top = static_cast<int>(pyramid_.size()) - 1;
-    for (int row = 0; row < pyramid_[top].rows; ++row) {
-      for (int col = 0; col < pyramid_[top].cols; ++col) Visit(top, col, row);
+  void WalkAllRoots(int first_stored, int top) {
+    const PyramidView stored{buffers_.stored, first_stored, cv::Point(0, 0)};
+    for (int row = 0; row < stored.Level(top).rows; ++row) {
+      for (int col = 0; col < stored.Level(top).cols; ++col) Visit(stored, top, col, row);
     }
   }
 
  private:
-  void Visit(int level, int col, int row) {
-    const Moments& square = pyramid_[level].at(col, row);
+  void Visit(const PyramidView& view, int level, int col, int row) {
+    const Moments& square = view.Level(level).at(col, row);
     if (square.count == 0) return;
     const int side = min_side_ << level;
     const int64_t area = int64_t(side) * side;
+    const cv::Point corner = view.origin + cv::Point(col * side, row * side);
     if (level == 0) {
-      if (2 * square.count >= area) Emit(square, col, row, side);
+      if (2 * square.count >= area) Emit(square, corner, side);
       return;
     }
     if (square.count == area && square.SpreadSquared() <= max_spread_squared_) {
-      Emit(square, col, row, side);
+      Emit(square, corner, side);
       return;
     }
-    const MomentGrid& finer = pyramid_[level - 1];
+    if (level == view.first) {
+      SplitFromPixels(corner, level);
+      return;
+    }
+    VisitQuarters(view, level - 1, col, row);
+  }
+
+  void VisitQuarters(const PyramidView& view, int quarter_level, int col, int row) {
+    const MomentGrid& finer = view.Level(quarter_level);
     for (int child_row = 2 * row; child_row <= 2 * row + 1; ++child_row) {
       for (int child_col = 2 * col; child_col <= 2 * col + 1; ++child_col) {
-        if (finer.Contains(child_col, child_row)) Visit(level - 1, child_col, child_row);
+        if (finer.Contains(child_col, child_row)) Visit(view, quarter_level, child_col, child_row);
       }
     }
   }
 
-  void Emit(const Moments& square, int col, int row, int side) {
+  // Splits the lowest stored square at `corner`: its levels below are summed from its pixels.
+  // Squares of these levels never split into stored ones, so the block buffer is not reentered.
+  void SplitFromPixels(const cv::Point& corner, int level) {
+    const int side = min_side_ << level;
+    const cv::Rect rect(corner.x, corner.y, std::min(side, size_.width - corner.x),
+                        std::min(side, size_.height - corner.y));
+    BuildPyramid(PixelArea{colors_, mask_, rect}, min_side_, 0, level - 1, &buffers_.run,
+                 &buffers_.block);
+    VisitQuarters(PyramidView{buffers_.block, 0, corner}, level - 1, 0, 0);
+  }
+
+  void Emit(const Moments& square, const cv::Point& corner, int side) {
     ImageGaussian leaf;
     const double centre_offset = 0.5 * (side - 1);
-    leaf.x = static_cast<float>(double(col) * side + centre_offset);
-    leaf.y = static_cast<float>(double(row) * side + centre_offset);
+    leaf.x = static_cast<float>(double(corner.x) + centre_offset);
+    leaf.y = static_cast<float>(double(corner.y) + centre_offset);
     leaf.sigma = 0.5f * side;
     for (int c = 0; c < 3; ++c) leaf.color[c] = static_cast<float>(square.sum[c] / square.count);
     leaves_->push_back(leaf);
   }
 
-  const std::vector<MomentGrid>& pyramid_;
+  const ColorRuns& colors_;
+  const cv::Mat& mask_;
+  const cv::Size size_;
   const int min_side_;
   const double max_spread_squared_;
+  BuildBuffers& buffers_;
   std::vector<ImageGaussian>* leaves_;
 };
 
@@ -156,19 +312,25 @@ void CheckImageAndMask(const cv::Mat& image, const cv::Mat& mask, const std::str
               std::to_string(image.rows));
 }
 
+// The lowest level the pyramid stores: the first whose squares have kMinStoredSide pixels.
+int FirstStoredLevel(const ImageGaussianOptions& options) {
+  int level = 0;
+  while (level < options.max_depth && (options.min_leaf_size << level) < kMinStoredSide) ++level;
+  return level;
+}
+
 ImageGaussians BuildChecked(const cv::Mat& image, const cv::Mat& mask,
                             const ImageGaussianOptions& options, const std::string& where) {
-  const cv::Mat colors =
-      image.type() == CV_8UC3 ? ConvertImage(image, options.color_space, where) : image;
-  std::vector<MomentGrid> pyramid;
-  pyramid.reserve(options.max_depth + 1);
-  pyramid.push_back(SmallestSquareMoments(colors, mask, options.min_leaf_size));
-  for (int level = 1; level <= options.max_depth; ++level) {
-    pyramid.push_back(CoarserMoments(pyramid.back()));
-  }
+  const ColorRuns colors(image, options.color_space, where);
+  BuildBuffers& buffers = ThreadBuildBuffers();
+  const int first_stored = FirstStoredLevel(options);
+  BuildStoredLevels(colors, mask, image.size(), options.min_leaf_size, first_stored,
+                    options.max_depth, &buffers);
   std::vector<ImageGaussian> leaves;
-  leaves.reserve(pyramid[0].cells.size() / 4);
-  QuadTreeWalker(pyramid, options, &leaves).WalkAllRoots();
+  leaves.reserve(size_t(CeilDiv(image.cols, options.min_leaf_size)) *
+                 CeilDiv(image.rows, options.min_leaf_size) / 4);
+  QuadTreeWalker(colors, mask, image.size(), options, &buffers, &leaves)
+      .WalkAllRoots(first_stored, options.max_depth);
   return ImageGaussians(image.cols, image.rows, options.color_space, std::move(leaves), where);
 }
 
@@ -183,6 +345,18 @@ int SizeExponent(float sigma) {
   uint32_t bits;
   std::memcpy(&bits, &sigma, sizeof(bits));
   return static_cast<int>((bits >> 23) & 0xffu) - 127;
+}
+
+// The indices of `keys` ordered by key, in their given order within a key (*order), and where
+// each key's run begins in that order (*begin, num_keys + 1 entries). Keys lie in [0, num_keys).
+void CountingSort(const std::vector<int>& keys, int num_keys, std::vector<int>* begin,
+                  std::vector<int>* order) {
+  begin->assign(num_keys + 1, 0);
+  for (int key : keys) ++(*begin)[key + 1];
+  for (int key = 0; key < num_keys; ++key) (*begin)[key + 1] += (*begin)[key];
+  std::vector<int> next(begin->begin(), begin->end() - 1);
+  order->resize(keys.size());
+  for (size_t i = 0; i < keys.size(); ++i) (*order)[next[keys[i]]++] = static_cast<int>(i);
 }
 
 }  // namespace
@@ -217,37 +391,38 @@ ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,
   }
   if (gaussians.empty()) return;
 
-  int min_exponent = SizeExponent(gaussians[0].sigma), max_exponent = min_exponent;
-  for (const ImageGaussian& g : gaussians) {
-    min_exponent = std::min(min_exponent, SizeExponent(g.sigma));
-    max_exponent = std::max(max_exponent, SizeExponent(g.sigma));
-  }
-  std::vector<std::vector<int>> members(max_exponent - min_exponent + 1);
-  for (int i = 0; i < static_cast<int>(gaussians.size()); ++i) {
-    members[SizeExponent(gaussians[i].sigma) - min_exponent].push_back(i);
-  }
+  std::vector<int> exponents(gaussians.size());
+  for (size_t i = 0; i < gaussians.size(); ++i) exponents[i] = SizeExponent(gaussians[i].sigma);
+  const auto extremes = std::minmax_element(exponents.begin(), exponents.end());
+  const int lowest = *extremes.first, num_classes = *extremes.second - lowest + 1;
+  for (int& exponent : exponents) exponent -= lowest;
+  std::vector<int> class_begin, by_class;
+  CountingSort(exponents, num_classes, &class_begin, &by_class);
   gaussians_.reserve(gaussians.size());
-  for (int k = 0; k < static_cast<int>(members.size()); ++k) {
-    if (!members[k].empty()) AppendSizeClass(gaussians, members[k], min_exponent + k);
+  for (size_t k = 0; k + 1 < class_begin.size(); ++k) {
+    const int* members = by_class.data() + class_begin[k];
+    const int count = class_begin[k + 1] - class_begin[k];
+    if (count > 0) AppendSizeClass(gaussians, members, count, lowest + static_cast<int>(k));
   }
 }
 
-void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all,
-                                     const std::vector<int>& members, int exponent) {
+void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all, const int* members,
+                                     int count, int exponent) {
   SizeClass size_class;
   size_class.begin = static_cast<int>(gaussians_.size());
   float min_x = all[members[0]].x, max_x = min_x;
   float min_y = all[members[0]].y, max_y = min_y;
-  for (int i : members) {
-    size_class.max_sigma = std::max(size_class.max_sigma, all[i].sigma);
-    min_x = std::min(min_x, all[i].x);
-    max_x = std::max(max_x, all[i].x);
-    min_y = std::min(min_y, all[i].y);
-    max_y = std::max(max_y, all[i].y);
+  for (int j = 0; j < count; ++j) {
+    const ImageGaussian& g = all[members[j]];
+    size_class.max_sigma = std::max(size_class.max_sigma, g.sigma);
+    min_x = std::min(min_x, g.x);
+    max_x = std::max(max_x, g.x);
+    min_y = std::min(min_y, g.y);
+    max_y = std::max(max_y, g.y);
   }
   // A cell the side of the class's smallest square holds about one quad-tree leaf; a class that
   // is sparse over its extent gets coarser cells, keeping the grid within ~4 cells per Gaussian.
-  const double max_cells = 4.0 * members.size() + 64.0;
+  const double max_cells = 4.0 * count + 64.0;
   size_class.cell = std::ldexp(1.0, exponent + 1);
   while ((double(max_x - min_x) / size_class.cell + 1.0) *
              (double(max_y - min_y) / size_class.cell + 1.0) >
@@ -259,15 +434,12 @@ void ImageGaussians::AppendSizeClass(const std::vector<ImageGaussian>& all,
   size_class.cols = static_cast<int>((max_x - min_x) / size_class.cell) + 1;
   size_class.rows = static_cast<int>((max_y - min_y) / size_class.cell) + 1;
 
-  // Counting sort by cell: each cell's Gaussians, and each grid row's, end up contiguous.
-  const int num_cells = size_class.cols * size_class.rows;
-  size_class.cell_begin.assign(num_cells + 1, 0);
-  for (int i : members) ++size_class.cell_begin[size_class.CellOf(all[i]) + 1];
-  size_class.cell_begin[0] = size_class.begin;
-  for (int c = 0; c < num_cells; ++c) size_class.cell_begin[c + 1] += size_class.cell_begin[c];
-  std::vector<int> next(size_class.cell_begin.begin(), size_class.cell_begin.end() - 1);
-  gaussians_.resize(gaussians_.size() + members.size());
-  for (int i : members) gaussians_[next[size_class.CellOf(all[i])]++] = all[i];
+  // Sorted by cell: each cell's Gaussians, and each grid row's, end up contiguous.
+  std::vector<int> cells(count), by_cell;
+  for (int j = 0; j < count; ++j) cells[j] = size_class.CellOf(all[members[j]]);
+  CountingSort(cells, size_class.cols * size_class.rows, &size_class.cell_begin, &by_cell);
+  for (int& begin : size_class.cell_begin) begin += size_class.begin;
+  for (int j : by_cell) gaussians_.push_back(all[members[j]]);
   classes_.push_back(std::move(size_class));
 }
 

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include <omp.h>
+
 #include "finecap/util/error.h"
 
 namespace finecap {
@@ -35,6 +37,7 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
 std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& held_out,
                                               FrameInput* input) {
   std::vector<CalibratedImage> views;
+  const bool modelled = input->image_models.size() == input->images.size();
   FrameInput training;
   training.coarse = std::move(input->coarse);
   for (size_t c = 0; c < input->cameras.size(); ++c) {
@@ -44,8 +47,10 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
     } else {
       training.cameras.push_back(input->cameras[c]);
       training.images.push_back(input->images[c]);
+      if (modelled) training.image_models.push_back(std::move(input->image_models[c]));
     }
   }
+  training.image_model_options = input->image_model_options;
   *input = std::move(training);
   Require(!input->cameras.empty(), "SequenceOptions::held_out_cameras",
           "no camera other than the held-out ones could be read");
@@ -60,30 +65,45 @@ std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
   return views;
 }
 
-FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable)
-    : capture_(capture), skip_unreadable_(skip_unreadable) {}
+FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable,
+                               std::vector<std::string> held_out,
+                               std::optional<ImageGaussianOptions> image_options)
+    : capture_(capture),
+      skip_unreadable_(skip_unreadable),
+      held_out_(std::move(held_out)),
+      image_options_(std::move(image_options)) {}
 
 void FrameReadAhead::ReadAhead(int frame) {
-  if (pending_.valid()) return;
+  if (pending_.valid() || kept_frame_ == frame) return;
   pending_frame_ = frame;
-  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+  pending_ = std::async(std::launch::async, [this, frame] {
+    // One thread: the solve it overlaps has the cores, and one image modelled at a time holds
+    // one image's buffers, not one per core.
+    omp_set_num_threads(1);
+    return Read(frame);
+  });
 }
 
-FrameInput FrameReadAhead::Take(int frame, std::vector<SkippedCamera>* skipped) {
-  if (pending_.valid() && pending_frame_ == frame) {
-    Frame read = pending_.get();
-    *skipped = std::move(read.skipped);
-    return std::move(read.input);
+void FrameReadAhead::Keep(int frame, Frame read) {
+  kept_frame_ = frame;
+  kept_ = std::move(read);
+}
+
+FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
+  if (kept_frame_ == frame) {
+    kept_frame_ = -1;
+    return std::move(kept_);
   }
+  if (pending_.valid() && pending_frame_ == frame) return pending_.get();
   pending_ = {};  // Waits for a read of another frame, and drops it.
-  Frame read = Read(frame);
-  *skipped = std::move(read.skipped);
-  return std::move(read.input);
+  return Read(frame);
 }
 
 FrameReadAhead::Frame FrameReadAhead::Read(int frame) {
   Frame read;
   read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
+  read.held_out = TakeHeldOutViews(held_out_, &read.input);
+  if (image_options_) ModelFrameImages(*image_options_, &read.input);
   return read;
 }
 

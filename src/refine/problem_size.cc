@@ -18,13 +18,13 @@ constexpr int kSampledSurfaceGaussians = 3000;
 // subdivision levels and view-angle caps; 0.35 M to 85 M pairs, 115 MB to 890 MB), every one
 // within 4 % of its measured peak. The image Gaussians' own share is too small to measure.
 constexpr double kBaseMegabytes = 88.0;  // The process: code, libraries, thread stacks, allocator.
+// The 8-bit images and the buffers of one at a time.
 constexpr double kBytesPerPixel = 5.5;
 // The next frame's 8-bit images, read while this one is solved.
 constexpr double kBytesPerPixelReadAhead = 3.0;
 // The consensus similarity's patch residuals, Jacobians and member rows, per surface Gaussian and
 // camera that sees it.
-constexpr double kConsensusBytesPerObservation =
-    400.0;                             // The 8-bit images and the buffers of one at a time.
+constexpr double kConsensusBytesPerObservation = 400.0;
 constexpr double kBytesPerPair = 8.0;  // The image Gaussian's id and the pair's colour weight.
 // Residual blocks, neighbourhoods, the regulariser and the solver's sparse matrices, which grow
 // with the surface Gaussians (not with the cameras that see them): with conjugate gradients
@@ -58,10 +58,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
         static_cast<int>(std::count(camera.begin(), camera.end(), 1)));
   }
 
-  std::vector<std::string> names;
-  for (const Camera& camera : frame.cameras) names.push_back(camera.name);
-  const std::vector<ImageGaussians> images =
-      BuildFrameImageGaussians(frame.images, {}, options.image, names);
+  const std::vector<ImageGaussians> images = FrameImageModels(frame, options.image);
   const SurfaceGaussians surface =
       MakeSurfaceGaussians(fine.vertices, normals, model.refined_vertices(), colors);
   size.num_surface_gaussians = surface.size();

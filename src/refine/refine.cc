@@ -38,7 +38,36 @@ const RefineOptions& Checked(const RefineOptions& options) {
   return options;
 }
 
+bool SameImageModel(const ImageGaussianOptions& a, const ImageGaussianOptions& b) {
+  return a.color_space == b.color_space && a.max_depth == b.max_depth &&
+         a.min_leaf_size == b.min_leaf_size && a.split_threshold == b.split_threshold;
+}
+
+bool HasImageModels(const FrameInput& input, const ImageGaussianOptions& options) {
+  return !input.image_models.empty() && input.image_models.size() == input.images.size() &&
+         SameImageModel(input.image_model_options, options);
+}
+
+std::vector<ImageGaussians> BuildImageModels(const FrameInput& input,
+                                             const ImageGaussianOptions& options) {
+  std::vector<std::string> names;
+  for (const Camera& camera : input.cameras) names.push_back(camera.name);
+  return BuildFrameImageGaussians(input.images, {}, options, names);
+}
+
 }  // namespace
+
+void ModelFrameImages(const ImageGaussianOptions& options, FrameInput* input) {
+  if (HasImageModels(*input, options)) return;
+  input->image_models = BuildImageModels(*input, options);
+  input->image_model_options = options;
+}
+
+std::vector<ImageGaussians> FrameImageModels(const FrameInput& input,
+                                             const ImageGaussianOptions& options) {
+  if (HasImageModels(input, options)) return input.image_models;
+  return BuildImageModels(input, options);
+}
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
@@ -81,10 +110,7 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
   const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility);
   if (options.reference_colors == ReferenceColorSource::kImageModel) {
-    std::vector<std::string> names;
-    for (const Camera& camera : frame.cameras) names.push_back(camera.name);
-    const std::vector<ImageGaussians> images =
-        BuildFrameImageGaussians(frame.images, {}, options.image, names);
+    const std::vector<ImageGaussians> images = FrameImageModels(frame, options.image);
     return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
                                        options.sigma_hat, options.energy.overlap,
                                        options.energy.reach_sigmas);
@@ -105,9 +131,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   frame.normals = ComputeVertexNormals(frame.fine);
   const auto visible =
       ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
-  std::vector<std::string> names;
-  for (const Camera& camera : input.cameras) names.push_back(camera.name);
-  frame.images = BuildFrameImageGaussians(input.images, {}, options.image, names);
+  frame.images = FrameImageModels(input, options.image);
 
   // The consensus similarity compares the cameras of this frame with each other; the colours
   // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this

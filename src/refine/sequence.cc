@@ -187,9 +187,10 @@ class SequenceRun {
         log_(out, capture->frame_names(), options.mesh_format),
         model_(capture->ReadCoarseMesh(0), capture->vertex_mask(), options.refine,
                capture->mesh_path(0)),
+        reader_(capture, options.skip_unreadable_cameras, options.held_out_cameras,
+                options.refine.image),
         reference_colors_(LoadColors()),
-        regions_(SplitByTexture(model_, *capture)),
-        reader_(capture, options.skip_unreadable_cameras) {}
+        regions_(SplitByTexture(model_, *capture)) {}
 
   void Run(const FrameRange& frames, SequenceResult* result) {
     if (!FollowsColors(options_)) RequireNoFollowedColors();
@@ -216,10 +217,15 @@ class SequenceRun {
 
  private:
   ReferenceColors LoadColors() {
-    std::vector<SkippedCamera> skipped;
-    ReferenceColors colors = LoadOrComputeReferenceColors(model_, options_, capture_,
-                                                          ReferenceColorsPath(out_), &skipped);
-    ReportSkipped(options_.reference_frame, skipped);
+    const std::string path = ReferenceColorsPath(out_);
+    const int frame = options_.reference_frame;
+    if (fs::exists(path) || frame >= capture_->num_frames()) {
+      return LoadOrComputeReferenceColors(model_, options_, capture_, path);
+    }
+    FrameReadAhead::Frame reference = reader_.Take(frame);
+    ReportSkipped(frame, reference.skipped);
+    ReferenceColors colors = SaveReferenceColors(model_, options_, capture_, reference.input, path);
+    reader_.Keep(frame, std::move(reference));
     return colors;
   }
 
@@ -231,10 +237,11 @@ class SequenceRun {
 
   // The size of the first frame's problem and what it forecasts, before the long part of the run.
   void ReportProblemSize(const FrameRange& frames) {
-    FrameInput first = ReadFrameInput(capture_, frames.begin);
-    TakeHeldOutViews(options_.held_out_cameras, &first);  // Refine never sees them.
-    observer_->Starting(frames.size(), first,
-                        EstimateProblemSize(model_, reference_colors_, first, options_.refine));
+    FrameReadAhead::Frame first = reader_.Take(frames.begin);
+    observer_->Starting(
+        frames.size(), first.input,
+        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine));
+    reader_.Keep(frames.begin, std::move(first));
   }
 
   bool Done(int frame) const {
@@ -298,11 +305,11 @@ class SequenceRun {
   FrameStats RefineOne(int frame, const FrameRange& frames) {
     const std::string& name = capture_->frame_name(frame);
     const auto start = std::chrono::steady_clock::now();
-    std::vector<SkippedCamera> skipped;
-    FrameInput input = reader_.Take(frame, &skipped);
-    ReportSkipped(frame, skipped);
-    const std::vector<CalibratedImage> held_out =
-        TakeHeldOutViews(options_.held_out_cameras, &input);
+    FrameReadAhead::Frame read = reader_.Take(frame);
+    ReportSkipped(frame, read.skipped);
+    FrameInput& input = read.input;
+    const std::vector<CalibratedImage>& held_out = read.held_out;
+    const std::vector<SkippedCamera>& skipped = read.skipped;
     ReadAheadAfter(frame, frames);
     const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
     const ReferenceColors colors = ColorsFor(frame);
@@ -330,9 +337,11 @@ class SequenceRun {
   SequenceObserver* observer_;
   const StatsLog log_;
   const SequenceModel model_;
+  // Before the colours: the reference frame they are taken from is read by it and kept for the
+  // run (FrameReadAhead::Keep).
+  FrameReadAhead reader_;
   const ReferenceColors reference_colors_;
   const Regions regions_;
-  FrameReadAhead reader_;
 };
 
 }  // namespace
@@ -429,6 +438,12 @@ ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
   FrameInput reference =
       ReadFrameInput(capture, options.reference_frame, options.skip_unreadable_cameras, skipped);
   TakeHeldOutViews(options.held_out_cameras, &reference);  // Held-out cameras colour nothing.
+  return SaveReferenceColors(model, options, capture, reference, path);
+}
+
+ReferenceColors SaveReferenceColors(const SequenceModel& model, const SequenceOptions& options,
+                                    Capture* capture, const FrameInput& reference,
+                                    const std::string& path) {
   ReferenceColors colors = ComputeReferenceFrameColors(model, options, capture, reference);
   colors.recipe = ReferenceColorRecipe(options);
   WriteReferenceColors(path, colors);

@@ -63,6 +63,17 @@ Eigen::Vector3f ConvertColor(const cv::Vec3b& bgr, ColorSpace space);
 // Throws Error(where, ...) when the image is empty or not CV_8UC3; `where` names the image.
 cv::Mat ConvertImage(const cv::Mat& bgr, ColorSpace space, const std::string& where);
 
+// Whether `space` is converted pixel by pixel with no vectorised library path (kHsv,
+// kChromaticity): ConvertPixels then gives, for any run of pixels, exactly the values
+// ConvertImage gives them, so an image may be converted a row, or a part of a row, at a time.
+bool ConvertsPixelByPixel(ColorSpace space);
+
+// The embedded coordinates of the `count` 8-bit BGR pixels at `bgr`, into out[0, count): bit for
+// bit ConvertImage's values for these pixels. Throws Error for a space that is not
+// ConvertsPixelByPixel (OpenCV converts those, and its vectorised code may round a pixel
+// differently depending on where a run of pixels starts).
+void ConvertPixels(const cv::Vec3b* bgr, int count, ColorSpace space, cv::Vec3f* out);
+
 // The distance between two embedded colours of the same space: the Euclidean norm of a - b in
 // every space above (the space is an argument so that a non-Euclidean metric could be added
 // without changing callers). Symmetric, zero only for equal colours, about [0, 1.7] in range.

@@ -21,11 +21,13 @@ struct CameraPairs {
   // The pairs of surface_ids[j] are image_ids[begin[j] .. begin[j + 1]).
   std::vector<int> begin;
   std::vector<int> image_ids;
-  // T(|eta_i - eta_s|) of each pair; pairs whose weight is zero are left out. All 1 when the
-  // pairs were built without colour weights.
+  // T(|eta_i - eta_s|) of each pair; pairs whose weight is zero are left out. Empty when the
+  // pairs were built without colour weights (every weight 1): a frame's pair lists hold millions
+  // of pairs.
   std::vector<float> color_weights;
 
   int num_pairs() const { return static_cast<int>(image_ids.size()); }
+  float color_weight(int pair) const { return color_weights.empty() ? 1.0f : color_weights[pair]; }
 };
 
 struct PairOptions {

@@ -5,6 +5,7 @@
 #define FINECAP_REFINE_FRAME_READER_H_
 
 #include <future>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -39,32 +40,45 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
 // The cameras and images of `input`, for the held-out score.
 std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
-// Reads frames (ReadFrameInput with `skip_unreadable`) one frame ahead on a thread of its own, so
-// that reading the next frame overlaps solving this one and both cores stay busy. Only this reader
-// may read images from the capture while a read is under way; at most one frame is read ahead
-// (bounded memory).
+// Reads frames as refinement sees them (ReadFrameInput with `skip_unreadable`, the cameras named
+// in `held_out` set aside, and, given `image_options`, the images modelled) one frame ahead on a
+// thread of its own, so that reading and modelling the next frame overlap solving this one. Only
+// this reader may read images from the capture while a read is under way; at most one frame is
+// read ahead and one kept (bounded memory).
 class FrameReadAhead {
  public:
-  FrameReadAhead(Capture* capture, bool skip_unreadable);
+  struct Frame {
+    FrameInput input;                       // Without the held-out cameras.
+    std::vector<CalibratedImage> held_out;  // TakeHeldOutViews.
+    std::vector<SkippedCamera> skipped;     // Cameras whose image could not be read.
+  };
 
-  // Starts reading `frame` in the background, unless a read is already under way.
+  FrameReadAhead(Capture* capture, bool skip_unreadable, std::vector<std::string> held_out,
+                 std::optional<ImageGaussianOptions> image_options);
+
+  // Starts reading `frame` in the background, unless a read is already under way or the frame
+  // is kept.
   void ReadAhead(int frame);
 
-  // The input of `frame`: the one read ahead when it is that frame (its errors are thrown here),
-  // else read now. The cameras skipped go to *skipped.
-  FrameInput Take(int frame, std::vector<SkippedCamera>* skipped);
+  // Frame `frame`: the one kept or read ahead when it is that frame (a read's errors are thrown
+  // here), else read now.
+  Frame Take(int frame);
+
+  // Keeps `read`, frame `frame`, for the next Take of that frame: a frame used before the run
+  // refines it (for the reference colours or the forecast) is not read and modelled again.
+  void Keep(int frame, Frame read);
 
  private:
-  struct Frame {
-    FrameInput input;
-    std::vector<SkippedCamera> skipped;
-  };
   Frame Read(int frame);
 
   Capture* capture_;
   bool skip_unreadable_;
+  std::vector<std::string> held_out_;
+  std::optional<ImageGaussianOptions> image_options_;
   int pending_frame_ = -1;
   std::future<Frame> pending_;
+  int kept_frame_ = -1;
+  Frame kept_;
 };
 
 }  // namespace finecap

@@ -119,7 +119,21 @@ struct FrameInput {
   Mesh coarse;
   std::vector<Camera> cameras;
   std::vector<cv::Mat> images;
+  // The images' models, one per camera, when already built (ModelFrameImages), with the options
+  // they were built with; empty otherwise. A frame's images are then modelled once, however many
+  // stages use them (the reference colours, the forecast, the solve), and can be modelled ahead,
+  // while the frame before is solved.
+  std::vector<ImageGaussians> image_models;
+  ImageGaussianOptions image_model_options;
 };
+
+// Builds input->image_models under `options`, unless they are already built with them.
+void ModelFrameImages(const ImageGaussianOptions& options, FrameInput* input);
+
+// The image models of `input` under `options`: a copy of its own when built with them, else
+// built now.
+std::vector<ImageGaussians> FrameImageModels(const FrameInput& input,
+                                             const ImageGaussianOptions& options);
 
 // The parts of the model that stay fixed over a sequence.
 class SequenceModel {

@@ -125,6 +125,13 @@ ReferenceColors LoadOrComputeReferenceColors(const SequenceModel& model,
                                              const std::string& path,
                                              std::vector<SkippedCamera>* skipped = nullptr);
 
+// The reference colours of `reference` (the reference frame, read, without its held-out cameras),
+// computed, saved at `path` with their recipe and read back, as LoadOrComputeReferenceColors does
+// when there is no file.
+ReferenceColors SaveReferenceColors(const SequenceModel& model, const SequenceOptions& options,
+                                    Capture* capture, const FrameInput& reference,
+                                    const std::string& path);
+
 // The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
 // vector when the capture has no true surface for the frame.
 Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
