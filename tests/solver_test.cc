@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <memory>
 #include <utility>
 
 #include <ceres/gradient_checker.h>
@@ -164,13 +165,19 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
   FrameEnergy& energy = scene.energy;
   const Eigen::VectorXd& k = scene.k;
   SimilarityTerm& term = energy.similarity();
-  term.PrepareResiduals(k, true);
+  // Prepared as in a solve; the full blocks then need the residuals: the paper's term, whose
+  // blocks mix one parameter and several, has them from the callback too.
+  Eigen::VectorXd point = k;
+  double seconds = 0.0;
+  SharedEvaluationCallback callback(&term, &point, &seconds);
+  callback.PrepareForEvaluation(true, true);
+  if (similarity != "paper") term.PrepareResiduals(k, true);
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
     const SimilarityBlockCost full(term, b);
     const ReducedSimilarityBlockCost reduced(term, b);
     const int p = static_cast<int>(full.parameter_block_sizes().size());
     ASSERT_EQ(reduced.parameter_block_sizes().size(), static_cast<size_t>(p));
-    EXPECT_EQ(reduced.num_residuals(), std::min(full.num_residuals(), p + 1));
+    EXPECT_EQ(reduced.num_residuals(), p == 1 ? 2 : std::min(full.num_residuals(), p + 1));
 
     // Evaluate both, with Jacobians and without; parameters are not read (the callback's).
     auto evaluate = [&](const ceres::CostFunction& cost, bool with_jacobians) {
@@ -201,6 +208,94 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
         tolerance)
         << "block " << b;
   }
+}
+
+// A term's own block summaries (consensus computes them without storing its residuals) are those
+// summed from its residuals and Jacobians.
+TEST_P(CeresCostTest, BlockSummariesAreThoseOfTheResiduals) {
+  const auto [similarity, overlap] = GetParam();
+  CostScene scene(similarity, overlap);
+  SimilarityTerm& term = scene.energy.similarity();
+  term.SimilarityTerm::PrepareBlockSummaries(scene.k);
+  std::vector<SimilarityTerm::BlockSummary> expected;
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  for (int b = 0; b < num_blocks; ++b) expected.push_back(term.BlockSummaryOf(b));
+  term.PrepareBlockSummaries(scene.k);
+  int single = 0;
+  for (int b = 0; b < num_blocks; ++b) {
+    if (term.residual_blocks()[b].parameters.size() != 1) continue;
+    ++single;
+    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    const double tolerance = 1e-12 * (1.0 + expected[b].squared_norm + expected[b].curvature);
+    EXPECT_NEAR(summary.squared_norm, expected[b].squared_norm, tolerance) << "block " << b;
+    EXPECT_NEAR(summary.gradient, expected[b].gradient, tolerance) << "block " << b;
+    EXPECT_NEAR(summary.curvature, expected[b].curvature, tolerance) << "block " << b;
+  }
+  if (similarity != "paper") {
+    EXPECT_EQ(single, num_blocks);
+  }
+}
+
+// With the secant curvature, a block of one parameter keeps its cost and gradient, models J^T J
+// until it has been evaluated at two points, then the secant of its gradient between them, held
+// within the bounds and never below g^2 / |r|^2.
+TEST_P(CeresCostTest, SecantBlocksKeepCostAndGradientAndModelTheSecant) {
+  const auto [similarity, overlap] = GetParam();
+  CostScene scene(similarity, overlap);
+  SimilarityTerm& term = scene.energy.similarity();
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  std::vector<std::unique_ptr<ReducedSimilarityBlockCost>> costs;
+  for (int b = 0; b < num_blocks; ++b) {
+    costs.push_back(std::make_unique<ReducedSimilarityBlockCost>(term, b, true));
+  }
+  // Block b's residuals and its Jacobian's one entry at k, with k_s taken from k.
+  auto evaluate = [&](int b, const Eigen::VectorXd& k, Eigen::Vector2d* r) {
+    const double value = k[term.residual_blocks()[b].parameters[0]];
+    const double* parameters[] = {&value};
+    double jacobian[2];
+    double* jacobians[] = {jacobian};
+    EXPECT_TRUE(costs[b]->Evaluate(parameters, r->data(), jacobians));
+    EXPECT_EQ(jacobian[1], 0.0);
+    return jacobian[0];
+  };
+  term.PrepareBlockSummaries(scene.k);
+  std::vector<double> first_gradient(num_blocks);
+  int single = 0, lowered = 0, raised = 0;
+  for (int b = 0; b < num_blocks; ++b) {
+    if (term.residual_blocks()[b].parameters.size() != 1) continue;
+    ++single;
+    Eigen::Vector2d r;
+    const double length = evaluate(b, scene.k, &r);
+    EXPECT_NEAR(length * length, term.BlockSummaryOf(b).curvature,
+                1e-12 * (1.0 + term.BlockSummaryOf(b).curvature))
+        << "block " << b;
+    first_gradient[b] = term.BlockSummaryOf(b).gradient;
+  }
+  if (single == 0) return;
+  const double step = 0.0003;
+  const Eigen::VectorXd moved = scene.k.array() + step;
+  term.PrepareBlockSummaries(moved);
+  for (int b = 0; b < num_blocks; ++b) {
+    if (term.residual_blocks()[b].parameters.size() != 1) continue;
+    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    Eigen::Vector2d r;
+    const double length = evaluate(b, moved, &r);
+    const double tolerance = 1e-9 * (1.0 + summary.squared_norm + summary.curvature);
+    EXPECT_NEAR(r.squaredNorm(), summary.squared_norm, tolerance) << "block " << b;
+    EXPECT_NEAR(length * r[0], summary.gradient, tolerance) << "block " << b;
+    const double secant = (summary.gradient - first_gradient[b]) / step;
+    double expected =
+        std::clamp(secant, ReducedSimilarityBlockCost::kMinSecantFactor * summary.curvature,
+                   ReducedSimilarityBlockCost::kMaxSecantFactor * summary.curvature);
+    if (summary.squared_norm > 0.0) {
+      expected = std::max(expected, summary.gradient * summary.gradient / summary.squared_norm);
+    }
+    EXPECT_NEAR(length * length, expected, 1e-6 * (1.0 + summary.curvature)) << "block " << b;
+    lowered += length * length < 0.999 * summary.curvature;
+    raised += length * length > 1.001 * summary.curvature;
+  }
+  // The scene's blocks are curved both ways: the secant is not J^T J.
+  EXPECT_GT(lowered + raised, 0);
 }
 
 // A similarity that says it is a least-squares term is one: its E is minus half the sum of

@@ -271,6 +271,9 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
   schema->AddEnum("solver.linear_solver", &solver->linear_solver,
                   "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on "
                   "the normal equations, or dense QR (tiny problems only).");
+  schema->AddEnum("solver.curvature", &solver->curvature,
+                  "Ceres: curvature of a similarity block's model, Gauss-Newton's J^T J or the "
+                  "secant of its gradient between its last two evaluations (within 0.3-3 J^T J).");
   schema->AddDoubleOrAuto("solver.initial_step", &solver->initial_step,
                           &refine->scene_lengths.initial_step,
                           "Gradient ascent: first step of the steepest k_s, m; " +

@@ -412,6 +412,22 @@ void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_j
   }
 }
 
+void ConsensusSimilarity::PrepareBlockSummaries(const Eigen::VectorXd& k) {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  summaries_.resize(num_blocks);
+#pragma omp parallel
+  {
+    std::vector<double> residuals, jacobian;
+#pragma omp for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      residuals.resize(blocks_[b].num_residuals);
+      jacobian.resize(residuals.size());
+      BlockAt(b, k[blocks_[b].parameters[0]], residuals.data(), jacobian.data());
+      summaries_[b] = Summarise(residuals.data(), jacobian.data(), blocks_[b].num_residuals);
+    }
+  }
+}
+
 void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
   const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
   if (!uniform) {

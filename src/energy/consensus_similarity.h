@@ -66,6 +66,9 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+  // Each block's summary straight from its residuals, without storing them (a frame's ~0.8 M
+  // residuals and as many derivatives, written and read back at every evaluation otherwise).
+  void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
   bool IsLeastSquares() const override { return true; }
   // Where every k_s is the same and the patches are flat (the plane sweep's samples), each
   // pair-list row's colour is interpolated once instead of once for every patch it belongs to.

@@ -20,4 +20,34 @@ void SimilarityTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* c
   }
 }
 
+SimilarityTerm::BlockSummary SimilarityTerm::Summarise(const double* residuals,
+                                                       const double* jacobian, int m) {
+  BlockSummary summary;
+  for (int r = 0; r < m; ++r) {
+    summary.squared_norm += residuals[r] * residuals[r];
+    summary.gradient += jacobian[r] * residuals[r];
+    summary.curvature += jacobian[r] * jacobian[r];
+  }
+  return summary;
+}
+
+void SimilarityTerm::PrepareBlockSummaries(const Eigen::VectorXd& k) {
+  PrepareResiduals(k, true);
+  const int num_blocks = static_cast<int>(residual_blocks().size());
+  summaries_.resize(num_blocks);
+#pragma omp parallel
+  {
+    std::vector<double> residuals, jacobian;
+#pragma omp for schedule(dynamic, 256)
+    for (int b = 0; b < num_blocks; ++b) {
+      const ResidualBlock& block = residual_blocks()[b];
+      if (block.parameters.size() != 1) continue;
+      residuals.resize(block.num_residuals);
+      jacobian.resize(block.num_residuals);
+      BlockResiduals(b, residuals.data(), jacobian.data());
+      summaries_[b] = Summarise(residuals.data(), jacobian.data(), block.num_residuals);
+    }
+  }
+}
+
 }  // namespace finecap

@@ -1,6 +1,7 @@
 #include "solvers/ceres_cost_functions.h"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include <Eigen/QR>
@@ -11,7 +12,11 @@ namespace finecap {
 
 SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k,
                                                    double* seconds)
-    : term_(term), k_(k), seconds_(seconds) {}
+    : term_(term), k_(k), seconds_(seconds), summaries_only_(true) {
+  for (const SimilarityTerm::ResidualBlock& block : term->residual_blocks()) {
+    if (block.parameters.size() != 1) summaries_only_ = false;
+  }
+}
 
 void SharedEvaluationCallback::PrepareForEvaluation(bool /*evaluate_jacobians*/,
                                                     bool new_evaluation_point) {
@@ -21,7 +26,11 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool /*evaluate_jacobians*/,
   // again without saying so.
   if (!new_evaluation_point || (prepared_.size() == k_->size() && prepared_ == *k_)) return;
   const internal::Stopwatch clock;
-  term_->PrepareResiduals(*k_, true);
+  if (summaries_only_) {
+    term_->PrepareBlockSummaries(*k_);
+  } else {
+    term_->SimilarityTerm::PrepareBlockSummaries(*k_);
+  }
   prepared_ = *k_;
   *seconds_ += clock.Seconds();
 }
@@ -52,19 +61,24 @@ bool SimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* 
   return true;
 }
 
-ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& term, int block)
-    : term_(term), block_(block), full_(term, block) {
+ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& term, int block,
+                                                       bool secant)
+    : term_(term), block_(block), full_(term, block), secant_(secant) {
   const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
   num_full_residuals_ = info.num_residuals;
   const int num_parameters = static_cast<int>(info.parameters.size());
-  set_num_residuals(std::min(num_full_residuals_, num_parameters + 1));
+  set_num_residuals(num_parameters == 1 ? 2 : std::min(num_full_residuals_, num_parameters + 1));
   mutable_parameter_block_sizes()->assign(num_parameters, 1);
 }
 
 bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, double* residuals,
                                           double** jacobians) const {
-  const int m = num_full_residuals_;
   const int p = static_cast<int>(parameter_block_sizes().size());
+  if (p == 1) {
+    EvaluateOneParameter(parameters[0][0], residuals, jacobians);
+    return true;
+  }
+  const int m = num_full_residuals_;
   thread_local Eigen::VectorXd r;
   thread_local Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jacobian;
   r.resize(m);
@@ -79,16 +93,9 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
   term_.BlockResiduals(block_, r.data(), jacobian.data());
   const double squared_norm = r.squaredNorm();
   Eigen::MatrixXd reduced = Eigen::MatrixXd::Zero(p + 1, p);  // [R; 0].
-  Eigen::VectorXd along(p);                                   // Q^T r.
-  if (p == 1) {
-    const double length = jacobian.col(0).norm();
-    along[0] = length > 0.0 ? jacobian.col(0).dot(r) / length : 0.0;
-    reduced(0, 0) = length;
-  } else {
-    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(jacobian);
-    along = (qr.householderQ().transpose() * r).head(p);
-    reduced.topRows(p) = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
-  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(jacobian);
+  const Eigen::VectorXd along = (qr.householderQ().transpose() * r).head(p);  // Q^T r.
+  reduced.topRows(p) = qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
   for (int i = 0; i < p; ++i) residuals[i] = along[i];
   // What of r no step can reduce; rounding may make the difference a hair negative.
   residuals[p] = std::sqrt(std::max(0.0, squared_norm - along.squaredNorm()));
@@ -97,6 +104,49 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
     for (int i = 0; i <= p; ++i) jacobians[q][i] = reduced(i, q);
   }
   return true;
+}
+
+double ReducedSimilarityBlockCost::ModelCurvature(
+    double k, const SimilarityTerm::BlockSummary& summary) const {
+  if (!secant_) return summary.curvature;
+  // Steps shorter than this (metres) are rounding: their secant is noise.
+  constexpr double kMinSpan = 1e-9;
+  const bool moved = !has_last_ || std::abs(k - last_k_) > kMinSpan;
+  double curvature = summary.curvature;
+  if (has_last_ && moved) {
+    const double secant = (summary.gradient - last_gradient_) / (k - last_k_);
+    curvature = std::clamp(secant, kMinSecantFactor * summary.curvature,
+                           kMaxSecantFactor * summary.curvature);
+    // J^T J >= g^2 / |r|^2 always (Cauchy-Schwarz); a lower h must not go below it.
+    if (summary.squared_norm > 0.0) {
+      curvature = std::max(curvature, summary.gradient * summary.gradient / summary.squared_norm);
+    }
+  }
+  if (moved) {
+    has_last_ = true;
+    last_k_ = k;
+    last_gradient_ = summary.gradient;
+  }
+  return curvature;
+}
+
+void ReducedSimilarityBlockCost::EvaluateOneParameter(double k, double* residuals,
+                                                      double** jacobians) const {
+  const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(block_);
+  if (jacobians == nullptr) {
+    residuals[0] = std::sqrt(summary.squared_norm);
+    residuals[1] = 0.0;
+    return;
+  }
+  // R = sqrt(h) and Q^T r = J^T r / R, h = J^T J but for the secant.
+  const double length = std::sqrt(ModelCurvature(k, summary));
+  residuals[0] = length > 0.0 ? summary.gradient / length : 0.0;
+  // What of r no step can reduce; rounding may make the difference a hair negative.
+  residuals[1] = std::sqrt(std::max(0.0, summary.squared_norm - residuals[0] * residuals[0]));
+  if (jacobians[0] != nullptr) {
+    jacobians[0][0] = length;
+    jacobians[0][1] = 0.0;
+  }
 }
 
 IsolatedSimilarityBlockCost::IsolatedSimilarityBlockCost(SimilarityTerm* term, int block,

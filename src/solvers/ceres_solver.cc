@@ -45,7 +45,8 @@ void AddSmoothnessResiduals(const FrameEnergy& energy, Eigen::VectorXd* k,
   }
 }
 
-void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* problem) {
+void AddResiduals(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
+                  ceres::Problem* problem) {
   const double k_max = energy->options().k_max;
   for (int s = 0; s < k->size(); ++s) {
     problem->AddParameterBlock(&(*k)[s], 1);
@@ -57,15 +58,40 @@ void AddResiduals(FrameEnergy* energy, Eigen::VectorXd* k, ceres::Problem* probl
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
     blocks.clear();
     for (int s : term.residual_blocks()[b].parameters) blocks.push_back(&(*k)[s]);
-    problem->AddResidualBlock(new ReducedSimilarityBlockCost(term, b), nullptr, blocks);
+    problem->AddResidualBlock(
+        new ReducedSimilarityBlockCost(term, b, options.curvature == CurvatureModel::kSecant),
+        nullptr, blocks);
   }
   AddSmoothnessResiduals(*energy, k, problem);
 }
 
+// Stops the solve when a step taken lowers the cost by no more than `tolerance` times the cost
+// before it. Ceres' own function tolerance also judges the steps it rejects, and ended solves on
+// a rejected step whose change was small, before a shorter step was tried (synth_skirt frames
+// 0-3: 2.621 against 2.636 mm RMS with Gauss-Newton curvature, 14.5 evaluations per frame both;
+// 2.571 against 2.583 mm with the secant, 13 both).
+class StopOnSmallDecrease : public ceres::IterationCallback {
+ public:
+  explicit StopOnSmallDecrease(double tolerance) : tolerance_(tolerance) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
+    // `cost` is after the step, `cost_change` what the step took off.
+    const bool converged =
+        iteration.iteration > 0 && iteration.step_is_successful &&
+        iteration.cost_change <= tolerance_ * (iteration.cost + iteration.cost_change);
+    stopped_ = stopped_ || converged;
+    return converged ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+  bool stopped() const { return stopped_; }
+
+ private:
+  double tolerance_;
+  bool stopped_ = false;
+};
+
 ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
   ceres::Solver::Options ceres_options;
   ceres_options.max_num_iterations = options.max_iterations;
-  ceres_options.function_tolerance = options.function_tolerance;
+  ceres_options.function_tolerance = 0.0;  // StopOnSmallDecrease instead.
   ceres_options.num_threads = options.num_threads > 0
                                   ? options.num_threads
                                   : static_cast<int>(std::thread::hardware_concurrency());
@@ -100,11 +126,13 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &shared;
   ceres::Problem problem(problem_options);
-  AddResiduals(energy, k, &problem);
+  AddResiduals(energy, options, k, &problem);
 
   ceres::Solver::Options ceres_options = MakeCeresOptions(options);
   TraceRecorder recorder(clock, summary);
   ceres_options.callbacks.push_back(&recorder);
+  StopOnSmallDecrease stop(options.function_tolerance);
+  ceres_options.callbacks.push_back(&stop);
   ceres::Solver::Summary ceres_summary;
   ceres::Solve(ceres_options, &problem, &ceres_summary);
   VLOG(1) << ceres_summary.FullReport();
@@ -115,7 +143,9 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   }
   summary->iterations = static_cast<int>(ceres_summary.iterations.size()) - 1;
   summary->evaluations = ceres_summary.num_residual_evaluations;
-  summary->termination = ceres::TerminationTypeToString(ceres_summary.termination_type);
+  summary->termination = stop.stopped()
+                             ? "CONVERGENCE (function tolerance)"
+                             : ceres::TerminationTypeToString(ceres_summary.termination_type);
   summary->seconds = clock.Seconds();
   summary->seconds_evaluation = ceres_summary.residual_evaluation_time_in_seconds +
                                 ceres_summary.jacobian_evaluation_time_in_seconds;

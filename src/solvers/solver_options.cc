@@ -37,6 +37,12 @@ const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType) {
   return names;
 }
 
+const std::vector<EnumName<CurvatureModel>>& EnumNames(CurvatureModel) {
+  static const std::vector<EnumName<CurvatureModel>> names = {
+      {CurvatureModel::kGaussNewton, "gauss_newton"}, {CurvatureModel::kSecant, "secant"}};
+  return names;
+}
+
 void SolverOptions::Check() const {
   RequireKnownChoice(type, "SolverOptions::type");
   RequireFieldRange(max_iterations, 0, 100000, "SolverOptions::max_iterations");
@@ -44,6 +50,7 @@ void SolverOptions::Check() const {
   Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
   RequireKnownChoice(trust_region, "SolverOptions::trust_region");
   RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
+  RequireKnownChoice(curvature, "SolverOptions::curvature");
   // Ceres' dogleg needs the exact Gauss-Newton step, which conjugate gradients do not give.
   Require(type != SolverType::kCeres || trust_region != TrustRegionType::kDogleg ||
               linear_solver != LinearSolverType::kCgnr,

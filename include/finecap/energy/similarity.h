@@ -47,6 +47,21 @@ class SimilarityTerm {
   // d residual r / d k of parameters[p], P = parameters.size().
   virtual void BlockResiduals(int block, double* residuals, double* jacobian) const = 0;
 
+  // What a least-squares solver's linear model of a block of one parameter k_s is made of: its
+  // sum of squares |r|^2, gradient J^T r and Gauss-Newton curvature J^T J.
+  struct BlockSummary {
+    double squared_norm = 0.0;
+    double gradient = 0.0;
+    double curvature = 0.0;
+  };
+  // Computes the BlockSummary of every block of one parameter at `k` (blocks of several are left
+  // out); BlockSummaryOf then reads them, from any number of threads, until the next call.
+  // BlockResiduals is not valid after it, but for this default implementation, which prepares
+  // the residuals with Jacobians and sums them (a term may compute its summaries without storing
+  // every residual).
+  virtual void PrepareBlockSummaries(const Eigen::VectorXd& k);
+  const BlockSummary& BlockSummaryOf(int block) const { return summaries_[block]; }
+
   // costs[b] = the sum of squares of block b's residuals at k, for every block. Prepares the
   // residuals at k (without Jacobians) and sums them; a term may know a faster way.
   virtual void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs);
@@ -54,6 +69,11 @@ class SimilarityTerm {
   // True when Evaluate(k) is exactly minus half the sum of squares of the residuals at k: then
   // the least-squares cost gives the similarity too, and a solver need not evaluate both.
   virtual bool IsLeastSquares() const { return false; }
+
+ protected:
+  // The block's summary from its residuals r and row-major Jacobian (one column), m residuals.
+  static BlockSummary Summarise(const double* residuals, const double* jacobian, int m);
+  std::vector<BlockSummary> summaries_;  // PrepareBlockSummaries' results, one per block.
 };
 
 }  // namespace finecap
