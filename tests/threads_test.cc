@@ -1,6 +1,12 @@
 #include "finecap/util/threads.h"
 
+#include <malloc.h>
 #include <omp.h>
+
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -31,6 +37,39 @@ TEST(SetWorkerThreadsTest, LimitsTheOpenMpStagesAndRestoresTheDefault) {
 }
 
 TEST(SetWorkerThreadsTest, RefusesANegativeCount) { EXPECT_THROW(SetWorkerThreads(-1), Error); }
+
+// The heaps glibc's malloc has now (malloc_info's <heap> elements).
+int MallocHeaps() {
+  char* text = nullptr;
+  size_t size = 0;
+  FILE* stream = open_memstream(&text, &size);
+  malloc_info(0, stream);
+  std::fclose(stream);
+  const std::string info(text, size);
+  std::free(text);
+  int heaps = 0;
+  for (size_t at = info.find("<heap nr="); at != std::string::npos;
+       at = info.find("<heap nr=", at + 1)) {
+    ++heaps;
+  }
+  return heaps;
+}
+
+// Threads that allocate at once all allocate from the one arena.
+TEST(UseOneMallocArenaTest, ThreadsAllocatingAtOnceShareOneHeap) {
+  UseOneMallocArena();
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([] {
+      for (int i = 0; i < 2000; ++i) {
+        std::vector<char> buffer(64 + i);
+        buffer[0] = 1;
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(MallocHeaps(), 1);
+}
 
 }  // namespace
 }  // namespace finecap

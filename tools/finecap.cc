@@ -227,6 +227,7 @@ int Main(int argc, char** argv) {
 
 int main(int argc, char** argv) {
   finecap::RestartWithSleepingWorkers(argv);
+  finecap::UseOneMallocArena();
   try {
     return finecap::Main(argc, argv);
   } catch (const finecap::Error& error) {

@@ -1,5 +1,6 @@
 #include "finecap/util/threads.h"
 
+#include <malloc.h>
 #include <omp.h>
 #include <unistd.h>
 
@@ -21,5 +22,7 @@ void RestartWithSleepingWorkers(char** argv) {
   if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
   execv("/proc/self/exe", argv);  // Returns only if it failed.
 }
+
+void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }
 
 }  // namespace finecap
