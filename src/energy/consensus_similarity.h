@@ -109,8 +109,9 @@ class ConsensusSimilarity : public SimilarityTerm {
   };
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
-  // The nodes of one row of `view`'s pair list: ImageColorOfPairs at each node, with the row's
-  // image Gaussians gathered once (into `paired`) instead of once per node.
+  // The nodes of one row of `view`'s pair list: ImageColorOfPairs over the image Gaussians in
+  // reach at each node, with the row's image Gaussians gathered once (into `paired`) instead of
+  // once per node.
   void TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
                    TableNode* nodes) const;
   // Colours of every row of every camera's pair list at one k, [c][row].

@@ -85,6 +85,7 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
   // concatenated in order: a few hundred allocations instead of two per surface Gaussian.
   constexpr int kRun = 256;
   const int num_runs = (n + kRun - 1) / kRun;
+  const auto run_end = [n](int run) { return std::min(n, (run + 1) * kRun); };
   std::vector<std::vector<int>> ids(num_runs);
   std::vector<std::vector<float>> weights(num_runs);
   pairs.begin.assign(n + 1, 0);
@@ -93,7 +94,7 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
     std::vector<int> reached;
 #pragma omp for schedule(dynamic, 1)
     for (int run = 0; run < num_runs; ++run) {
-      for (int j = run * kRun; j < std::min(n, (run + 1) * kRun); ++j) {
+      for (int j = run * kRun; j < run_end(run); ++j) {
         PairsOf(camera, image, surface, pairs.surface_ids[j], options, &reached, &ids[run],
                 &weights[run]);
         pairs.begin[j + 1] = static_cast<int>(ids[run].size());  // Within the run, for now.
@@ -105,7 +106,7 @@ CameraPairs BuildCameraPairs(const Camera& camera, const ImageGaussians& image,
                       [](size_t sum, const auto& run) { return sum + run.size(); }));
   for (int run = 0; run < num_runs; ++run) {
     const int offset = static_cast<int>(pairs.image_ids.size());
-    for (int j = run * kRun; j < std::min(n, (run + 1) * kRun); ++j) pairs.begin[j + 1] += offset;
+    for (int j = run * kRun; j < run_end(run); ++j) pairs.begin[j + 1] += offset;
     pairs.image_ids.insert(pairs.image_ids.end(), ids[run].begin(), ids[run].end());
     pairs.color_weights.insert(pairs.color_weights.end(), weights[run].begin(), weights[run].end());
   }

@@ -1,6 +1,7 @@
 #include "finecap/refine/frame_reader.h"
 
 #include <algorithm>
+#include <utility>
 
 #include <omp.h>
 
@@ -90,10 +91,10 @@ void FrameReadAhead::Keep(int frame, Frame read) {
 }
 
 FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
-  if (kept_frame_ == frame) {
-    kept_frame_ = -1;
-    return std::move(kept_);
-  }
+  const int kept_frame = std::exchange(kept_frame_, -1);
+  Frame kept = std::move(kept_);
+  kept_ = {};
+  if (kept_frame == frame) return kept;
   if (pending_.valid() && pending_frame_ == frame) return pending_.get();
   pending_ = {};  // Waits for a read of another frame, and drops it.
   return Read(frame);

@@ -44,7 +44,7 @@ bool SameImageModel(const ImageGaussianOptions& a, const ImageGaussianOptions& b
 }
 
 bool HasImageModels(const FrameInput& input, const ImageGaussianOptions& options) {
-  return !input.image_models.empty() && input.image_models.size() == input.images.size() &&
+  return input.image_models.size() == input.images.size() &&
          SameImageModel(input.image_model_options, options);
 }
 

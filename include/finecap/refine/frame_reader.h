@@ -65,7 +65,8 @@ class FrameReadAhead {
   Frame Take(int frame);
 
   // Keeps `read`, frame `frame`, for the next Take of that frame: a frame used before the run
-  // refines it (for the reference colours or the forecast) is not read and modelled again.
+  // refines it (for the reference colours or the forecast) is not read and modelled again. A Take
+  // of another frame drops it (a resumed run may never refine it).
   void Keep(int frame, Frame read);
 
  private:
