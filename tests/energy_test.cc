@@ -208,7 +208,11 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
     const double step = 2.0 * options.k_max / (num_nodes - 1);
     int compared = 0;
     for (int c = 0; c < static_cast<int>(energy.views().size()); ++c) {
-      const EnergyView& view = energy.views()[c];
+      // The energy released its pair lists once the tables were built: the same lists again.
+      EnergyView view = energy.views()[c];
+      view.pairs = BuildCameraPairs(view.camera, *view.image, energy.surface(),
+                                    scene.cameras[c].visible, EnergyPairOptions(options));
+      ASSERT_EQ(view.pairs.surface_ids, energy.views()[c].pairs.surface_ids);
       for (int row = 0; row < static_cast<int>(view.pairs.surface_ids.size()); row += 7) {
         const Eigen::Vector3d own =
             energy.surface().colors[view.pairs.surface_ids[row]].cast<double>();
@@ -233,6 +237,26 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
 
 // A plain surface (every image Gaussian the same colour) gives the consensus nothing to agree
 // on: no weight, no residual, no pull anywhere.
+// The consensus similarity reads only its tables once built, so the energy keeps no image
+// Gaussian ids of its pairs, but counts them; a similarity that reads its pairs keeps them.
+TEST(FrameEnergyTest, ReleasesThePairListsOfASimilarityThatDoesNotReadThem) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
+  for (const std::string similarity : {"consensus", "surface_color"}) {
+    const EnergyOptions options = Options(similarity, "exact");
+    const FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+    long pairs = 0, kept = 0;
+    for (size_t c = 0; c < energy.views().size(); ++c) {
+      pairs += BuildCameraPairs(scene.cameras[c].camera, *scene.cameras[c].image, energy.surface(),
+                                scene.cameras[c].visible, EnergyPairOptions(options))
+                   .num_pairs();
+      kept += energy.views()[c].pairs.num_pairs();
+    }
+    EXPECT_GT(pairs, 0) << similarity;
+    EXPECT_EQ(energy.num_pairs(), pairs) << similarity;
+    EXPECT_EQ(kept, similarity == "consensus" ? 0 : pairs) << similarity;
+  }
+}
+
 TEST(ConsensusSimilarityTest, PlainSurfaceCarriesNoWeight) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 3, 5);
   for (auto& image : scene.images) {

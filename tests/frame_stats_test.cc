@@ -34,6 +34,7 @@ FrameStats SampleStats() {
   stats.pairs = 821000;
   stats.worse = true;
   stats.kept_input = false;
+  stats.prepared_ahead = true;
   stats.rms_coarse_mm = 8.37;
   stats.rms_refined_mm = std::nan("");
   stats.rms_textureless_coarse_mm = 0.0;
@@ -72,6 +73,7 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
   EXPECT_EQ(back.pairs, 821000);
   EXPECT_TRUE(back.worse);
   EXPECT_FALSE(back.kept_input);
+  EXPECT_TRUE(back.prepared_ahead);
   EXPECT_EQ(back.skipped_cameras, stats.skipped_cameras);
   // Written again, the record is the same text.
   EXPECT_EQ(ToJson(back), ToJson(stats));

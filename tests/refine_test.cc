@@ -83,6 +83,43 @@ TEST_F(RefineFrameTest, ImagesModelledAheadServeTheSameOptionsOnly) {
   EXPECT_TRUE((ahead == now || (ahead.isNaN() && now.isNaN())).all());
 }
 
+// A frame prepared ahead (PrepareFrameAhead: the energy and the plane sweep's start, with the
+// input's image models taken) solves to exactly the frame that RefineFrame prepares itself, from
+// the sweep and from a given start alike; with a schedule, the sweep is left to the coarsest
+// level.
+TEST_F(RefineFrameTest, AFramePreparedAheadSolvesAsOnePreparedInPlace) {
+  Capture capture = Capture::Open(*directory_);
+  RefineOptions options;
+  const FrameInput input = ReadFrameInput(&capture, 1);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, ReadFrameInput(&capture, 0), options);
+  const auto same = [](const Eigen::ArrayXd& a, const Eigen::ArrayXd& b) {
+    return a.size() == b.size() && (a == b || (a.isNaN() && b.isNaN())).all();
+  };
+
+  FrameInput read = input;
+  PreparedFrame ahead = PrepareFrameAhead(model, colors, &read, options);
+  EXPECT_TRUE(read.image_models.empty());
+  ASSERT_EQ(ahead.sweep_start.size(), ahead.energy->num_parameters());
+  ASSERT_GT(ahead.sweep_start.size(), 0);
+  const FrameResult in_place = RefineFrame(model, colors, input, options);
+  const FrameResult prepared = RefineFrame(model, colors, read, options, nullptr, std::move(ahead));
+  EXPECT_TRUE(prepared.prepared_ahead);
+  EXPECT_FALSE(in_place.prepared_ahead);
+  EXPECT_TRUE(same(prepared.k.array(), in_place.k.array()));
+
+  const Eigen::VectorXd start = Eigen::VectorXd::Constant(model.num_fine_vertices(), 0.001);
+  read = input;
+  EXPECT_TRUE(same(RefineFrameFrom(model, colors, read, options, start,
+                                   PrepareFrameAhead(model, colors, &read, options))
+                       .k.array(),
+                   RefineFrameFrom(model, colors, input, options, start).k.array()));
+
+  options.coarse_to_fine.levels = 2;
+  read = input;
+  EXPECT_EQ(PrepareFrameAhead(model, colors, &read, options).sweep_start.size(), 0);
+}
+
 // Every entry point checks its options, so that a library caller's bad value is refused naming
 // the field instead of selecting a default.
 TEST_F(RefineFrameTest, EntryPointsRefuseBadOptionsNamingTheField) {

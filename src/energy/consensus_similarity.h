@@ -70,6 +70,8 @@ class ConsensusSimilarity : public SimilarityTerm {
   // residuals and as many derivatives, written and read back at every evaluation otherwise).
   void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
   bool IsLeastSquares() const override { return true; }
+  // The tables hold all it reads of the pairs.
+  bool ReadsPairLists() const override { return false; }
   // Where every k_s is the same and the patches are flat (the plane sweep's samples), each
   // pair-list row's colour is interpolated once instead of once for every patch it belongs to.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;

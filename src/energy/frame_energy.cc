@@ -92,13 +92,15 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
     plain_cloth = PlainCloth(surface_, regularizer_, options_);
   }
   prior_curvature_ = PriorCurvature(data_curvature, plain_cloth, surface_.size(), options_);
+  for (EnergyView& view : views_) {
+    num_pairs_ += view.pairs.num_pairs();
+    if (similarity_->ReadsPairLists()) continue;
+    std::vector<int>().swap(view.pairs.image_ids);
+    std::vector<float>().swap(view.pairs.color_weights);
+  }
 }
 
-long FrameEnergy::num_pairs() const {
-  long pairs = 0;
-  for (const EnergyView& view : views_) pairs += view.pairs.num_pairs();
-  return pairs;
-}
+long FrameEnergy::num_pairs() const { return num_pairs_; }
 
 double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient,
                              double* similarity, double* regularization) const {

@@ -8,6 +8,23 @@
 #include "finecap/util/error.h"
 
 namespace finecap {
+namespace {
+
+// The calling thread's OpenMP threads for parallel regions, `threads` while in scope.
+class ScopedOpenMpThreads {
+ public:
+  explicit ScopedOpenMpThreads(int threads) : saved_(omp_get_max_threads()) {
+    omp_set_num_threads(threads);
+  }
+  ~ScopedOpenMpThreads() { omp_set_num_threads(saved_); }
+  ScopedOpenMpThreads(const ScopedOpenMpThreads&) = delete;
+  ScopedOpenMpThreads& operator=(const ScopedOpenMpThreads&) = delete;
+
+ private:
+  int saved_;
+};
+
+}  // namespace
 
 FrameInput ReadFrameInput(Capture* capture, int frame) {
   return ReadFrameInput(capture, frame, false, nullptr);
@@ -68,21 +85,24 @@ std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
 
 FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable,
                                std::vector<std::string> held_out,
-                               std::optional<ImageGaussianOptions> image_options)
+                               std::optional<ImageGaussianOptions> image_options,
+                               WorkAhead work_ahead)
     : capture_(capture),
       skip_unreadable_(skip_unreadable),
       held_out_(std::move(held_out)),
-      image_options_(std::move(image_options)) {}
+      image_options_(std::move(image_options)),
+      work_ahead_(std::move(work_ahead)),
+      threads_(omp_get_max_threads()) {}
+
+void FrameReadAhead::DropPending() {
+  if (pending_.valid()) pending_.wait();
+  pending_ = {};
+}
 
 void FrameReadAhead::ReadAhead(int frame) {
   if (pending_.valid() || kept_frame_ == frame) return;
   pending_frame_ = frame;
-  pending_ = std::async(std::launch::async, [this, frame] {
-    // One thread: the solve it overlaps has the cores, and one image modelled at a time holds
-    // one image's buffers, not one per core.
-    omp_set_num_threads(1);
-    return Read(frame);
-  });
+  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
 }
 
 void FrameReadAhead::Keep(int frame, Frame read) {
@@ -96,15 +116,25 @@ FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
   kept_ = {};
   if (kept_frame == frame) return kept;
   if (pending_.valid() && pending_frame_ == frame) return pending_.get();
-  pending_ = {};  // Waits for a read of another frame, and drops it.
+  DropPending();  // A read of another frame.
   return Read(frame);
 }
 
 FrameReadAhead::Frame FrameReadAhead::Read(int frame) {
   Frame read;
-  read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
-  read.held_out = TakeHeldOutViews(held_out_, &read.input);
-  if (image_options_) ModelFrameImages(*image_options_, &read.input);
+  {
+    // The images one at a time: one image's modelling buffers, not one per thread, and while
+    // the frame before is solved the solve has the cores.
+    const ScopedOpenMpThreads one(1);
+    read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
+    read.held_out = TakeHeldOutViews(held_out_, &read.input);
+    if (image_options_) ModelFrameImages(*image_options_, &read.input);
+  }
+  if (work_ahead_) {
+    // In parallel: on two cores, whichever of it and the solve ends first leaves the other both.
+    const ScopedOpenMpThreads parallel(threads_);
+    work_ahead_(frame, &read);
+  }
   return read;
 }
 

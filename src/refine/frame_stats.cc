@@ -46,6 +46,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.pairs = result.num_pairs;
   stats.worse = result.worse;
   stats.kept_input = result.kept_input;
+  stats.prepared_ahead = result.prepared_ahead;
   stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
   stats.rms_textureless_coarse_mm = stats.rms_textureless_refined_mm = std::nan("");
   stats.peak_rss_mb = PeakResidentMegabytes();
@@ -72,6 +73,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
        << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
+       << ", \"prepared_ahead\": " << (s.prepared_ahead ? "true" : "false")
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
@@ -126,7 +128,9 @@ struct StatsFields {
   std::vector<std::pair<const char*, long FrameStats::*>> longs = {
       {"image_gaussians", &FrameStats::image_gaussians}, {"pairs", &FrameStats::pairs}};
   std::vector<std::pair<const char*, bool FrameStats::*>> bools = {
-      {"worse", &FrameStats::worse}, {"kept_input", &FrameStats::kept_input}};
+      {"worse", &FrameStats::worse},
+      {"kept_input", &FrameStats::kept_input},
+      {"prepared_ahead", &FrameStats::prepared_ahead}};
   std::vector<std::pair<const char*, std::vector<std::string> FrameStats::*>> lists = {
       {"skipped_cameras", &FrameStats::skipped_cameras}};
 };

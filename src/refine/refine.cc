@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include "energy/consensus_similarity.h"
 #include "finecap/energy/frame_energy.h"
@@ -121,17 +122,19 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 namespace {
 
-// PrepareFrame without checking `options`: the coarse levels of a schedule widen sigma_hat and the
-// leaves past the ranges that a configured value must lie in.
+// PrepareFrame without checking `options`, over the image models `images` of the input's images
+// under options.image: the coarse levels of a schedule widen sigma_hat and the leaves past the
+// ranges that a configured value must lie in.
 PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
-                           const FrameInput& input, const RefineOptions& options) {
+                           const FrameInput& input, const RefineOptions& options,
+                           std::vector<ImageGaussians> images) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
   frame.normals = ComputeVertexNormals(frame.fine);
   const auto visible =
       ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
-  frame.images = FrameImageModels(input, options.image);
+  frame.images = std::move(images);
 
   // The consensus similarity compares the cameras of this frame with each other; the colours
   // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this
@@ -162,7 +165,21 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
 PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options) {
   options.Check();
-  return PrepareLevel(model, colors, input, options);
+  return PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image));
+}
+
+PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColors& colors,
+                                FrameInput* input, const RefineOptions& options) {
+  options.Check();
+  const auto start = std::chrono::steady_clock::now();
+  ModelFrameImages(options.image, input);
+  PreparedFrame frame =
+      PrepareLevel(model, colors, *input, options, std::exchange(input->image_models, {}));
+  if (options.coarse_to_fine.levels == 1) {
+    frame.sweep_start = SweepInitialization(frame.energy.get(), options.sweep);
+  }
+  frame.seconds = SecondsSince(start);
+  return frame;
 }
 
 namespace {
@@ -201,8 +218,8 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
   return summary;
 }
 
-// Where the solve of a prepared frame starts: one k per surface Gaussian of `energy`.
-using StartingPointFunction = std::function<Eigen::VectorXd(FrameEnergy* energy)>;
+// Where the solve of a prepared frame starts: one k per surface Gaussian of its energy.
+using StartingPointFunction = std::function<Eigen::VectorXd(PreparedFrame* frame)>;
 
 // Level `level` of the coarse-to-fine schedule (0: the configured options): wider surface
 // Gaussians and larger image Gaussians, so that the energy is smoother in k and a fold further
@@ -229,9 +246,10 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     const RefineOptions level_options = LevelOptions(options, level);
     ReferenceColors level_colors = colors;
     level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
-    PreparedFrame frame = PrepareLevel(model, level_colors, input, level_options);
+    PreparedFrame frame = PrepareLevel(model, level_colors, input, level_options,
+                                       FrameImageModels(input, level_options.image));
     *seconds_preparation += frame.seconds;
-    if (k.size() == 0) k = starting_point(frame.energy.get());
+    if (k.size() == 0) k = starting_point(&frame);
     const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
     totals->iterations += summary.iterations;
     totals->evaluations += summary.evaluations;
@@ -243,10 +261,11 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
 }
 
 // RefineFrame, starting each level that does not continue from a coarser one at
-// `starting_point`.
+// `starting_point`; the configured level is `ahead` when that is not empty.
 FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
-                                  const StartingPointFunction& starting_point) {
+                                  const StartingPointFunction& starting_point,
+                                  PreparedFrame ahead) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   FrameResult result;
@@ -254,7 +273,11 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
                                                      &coarse, &result.seconds_preparation);
 
-  PreparedFrame frame = PrepareLevel(model, colors, input, options);
+  result.prepared_ahead = ahead.energy != nullptr;
+  PreparedFrame frame =
+      result.prepared_ahead
+          ? std::move(ahead)
+          : PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image));
   FrameEnergy& energy = *frame.energy;
   result.num_surface_gaussians = energy.num_parameters();
   result.num_image_gaussians = frame.num_image_gaussians;
@@ -262,7 +285,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   result.seconds_preparation += frame.seconds;
 
   // The frame got worse or better against where it started, before any level moved it.
-  const Eigen::VectorXd initial = starting_point(&energy);
+  const Eigen::VectorXd initial = starting_point(&frame);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   result.summary = SolveFrameEnergy(&energy, options, &k);
   if (coarse_k.size() > 0) {
@@ -313,34 +336,40 @@ void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
   result->kept_input = true;
 }
 
-Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,
                               const Eigen::VectorXd* warm_start) {
+  FrameEnergy* energy = frame->energy.get();
   if (warm_start != nullptr && warm_start->size() == energy->num_parameters()) return *warm_start;
+  if (frame->sweep_start.size() == energy->num_parameters()) return frame->sweep_start;
   return SweepInitialization(energy, sweep);
 }
 
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start) {
-  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
-    return StartingPoint(energy, options.sweep, warm_start);
-  });
+                        const Eigen::VectorXd* warm_start, PreparedFrame ahead) {
+  return RefineFrameStartingAt(
+      model, colors, input, options,
+      [&](PreparedFrame* frame) { return StartingPoint(frame, options.sweep, warm_start); },
+      std::move(ahead));
 }
 
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
                             const FrameInput& input, const RefineOptions& options,
-                            const Eigen::VectorXd& start) {
+                            const Eigen::VectorXd& start, PreparedFrame ahead) {
   Require(start.size() == model.num_fine_vertices(), "refine",
           "a start of " + std::to_string(start.size()) + " displacements for " +
               std::to_string(model.num_fine_vertices()) + " fine vertices");
-  return RefineFrameStartingAt(model, colors, input, options, [&](FrameEnergy* energy) {
-    Eigen::VectorXd k = SweepInitialization(energy, options.sweep);
-    const std::vector<int>& ids = energy->surface().vertex_ids;
-    for (size_t s = 0; s < ids.size(); ++s) {
-      if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];
-    }
-    return k;
-  });
+  return RefineFrameStartingAt(
+      model, colors, input, options,
+      [&](PreparedFrame* frame) {
+        Eigen::VectorXd k = StartingPoint(frame, options.sweep, nullptr);
+        const std::vector<int>& ids = frame->energy->surface().vertex_ids;
+        for (size_t s = 0; s < ids.size(); ++s) {
+          if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];
+        }
+        return k;
+      },
+      std::move(ahead));
 }
 
 }  // namespace finecap

@@ -110,10 +110,9 @@ Regions SplitByTexture(const SequenceModel& model, const Capture& capture) {
   return regions;
 }
 
-void AddGroundTruthErrors(const Capture& capture, const SequenceModel& model, const Mesh& coarse,
-                          int frame, const Regions& regions, const FrameResult& result,
-                          FrameStats* stats) {
-  const Eigen::VectorXd truth = TrueFineDisplacement(capture, model, coarse, frame);
+// `truth`: the frame's TrueFineDisplacement (empty: none).
+void AddGroundTruthErrors(const Eigen::VectorXd& truth, const Regions& regions,
+                          const FrameResult& result, FrameStats* stats) {
   if (truth.size() == 0) return;
   // Only where the result has a displacement: both figures over the same vertices.
   const Eigen::VectorXd input = result.k.array().isFinite().select(0.0 * result.k, result.k);
@@ -188,13 +187,17 @@ class SequenceRun {
         model_(capture->ReadCoarseMesh(0), capture->vertex_mask(), options.refine,
                capture->mesh_path(0)),
         reader_(capture, options.skip_unreadable_cameras, options.held_out_cameras,
-                options.refine.image),
+                options.refine.image,
+                [this](int frame, FrameReadAhead::Frame* read) { WorkAhead(frame, read); }),
         reference_colors_(LoadColors()),
         regions_(SplitByTexture(model_, *capture)) {}
+  // The reader's work ahead uses this run's members.
+  ~SequenceRun() { reader_.DropPending(); }
 
   void Run(const FrameRange& frames, SequenceResult* result) {
     if (!FollowsColors(options_)) RequireNoFollowedColors();
     ReportProblemSize(frames);
+    prepare_ahead_ = !FollowsColors(options_);
     double sum_coarse2 = 0.0, sum_refined2 = 0.0;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
       if (Done(frame)) {
@@ -293,6 +296,20 @@ class SequenceRun {
     WriteReferenceColors(FollowedColorsPath(out_, name), next);
   }
 
+  // On the reader's thread, while the frame before is solved: what refining `frame` needs that no
+  // other frame's result changes.
+  void WorkAhead(int frame, FrameReadAhead::Frame* read) const {
+    if (prepare_ahead_) {
+      read->prepared = PrepareFrameAhead(model_, reference_colors_, &read->input, options_.refine);
+      // Only the held-out score and the coarser levels of a schedule read the pixels after this:
+      // two frames' images are a run's largest buffers.
+      if (options_.held_out_cameras.empty() && options_.refine.coarse_to_fine.levels == 1) {
+        read->input.images.clear();
+      }
+    }
+    read->true_displacement = TrueFineDisplacement(*capture_, model_, read->input.coarse, frame);
+  }
+
   // Starts reading the first frame after `frame` that is still to do.
   void ReadAheadAfter(int frame, const FrameRange& frames) {
     for (int next = frame + 1; next < frames.end; ++next) {
@@ -314,14 +331,16 @@ class SequenceRun {
     const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
     const ReferenceColors colors = ColorsFor(frame);
     FrameResult result = warm_start.size() > 0
-                             ? RefineFrameFrom(model_, colors, input, options_.refine, warm_start)
-                             : RefineFrame(model_, colors, input, options_.refine);
+                             ? RefineFrameFrom(model_, colors, input, options_.refine, warm_start,
+                                               std::move(read.prepared))
+                             : RefineFrame(model_, colors, input, options_.refine, nullptr,
+                                           std::move(read.prepared));
     if (result.num_surface_gaussians == 0) observer_->NothingToRefine(name);
 
     FrameStats stats = MakeFrameStats(name, options_.refine, result);
     for (const SkippedCamera& camera : skipped) stats.skipped_cameras.push_back(camera.camera);
     ScoreInHeldOutViews(options_, model_, input, held_out, &result, &stats);
-    AddGroundTruthErrors(*capture_, model_, input.coarse, frame, regions_, result, &stats);
+    AddGroundTruthErrors(read.true_displacement, regions_, result, &stats);
     // Before the record, which marks the frame done: a done frame always has them.
     if (FollowsColors(options_) && frame >= options_.reference_frame) {
       SaveFollowedColors(name, colors, input, result, stats.worse);
@@ -337,6 +356,10 @@ class SequenceRun {
   SequenceObserver* observer_;
   const StatsLog log_;
   const SequenceModel model_;
+  // Whether the reader prepares each frame it reads: not until the colours are known and the
+  // first frame measured for the forecast, nor when each frame's colours follow the frame before.
+  // Before the reader, which reads the reference frame while the run is made.
+  bool prepare_ahead_ = false;
   // Before the colours: the reference frame they are taken from is read by it and kept for the
   // run (FrameReadAhead::Keep).
   FrameReadAhead reader_;

@@ -42,6 +42,8 @@ class FrameEnergy {
   int num_parameters() const { return surface_.size(); }
   const SurfaceGaussians& surface() const { return surface_; }
   const EnergyOptions& options() const { return options_; }
+  // The cameras' pair lists, without their image Gaussian ids when the similarity does not read
+  // them after it is built (SimilarityTerm::ReadsPairLists).
   const std::vector<EnergyView>& views() const { return views_; }
   SimilarityTerm& similarity() { return *similarity_; }
   const SimilarityTerm& similarity() const { return *similarity_; }
@@ -62,6 +64,7 @@ class FrameEnergy {
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;
   Eigen::VectorXd prior_curvature_;
+  long num_pairs_ = 0;
 };
 
 }  // namespace finecap

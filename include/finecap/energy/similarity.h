@@ -70,6 +70,10 @@ class SimilarityTerm {
   // the least-squares cost gives the similarity too, and a solver need not evaluate both.
   virtual bool IsLeastSquares() const { return false; }
 
+  // False when the term reads no image Gaussian ids of its views' pair lists once it is built;
+  // the frame's energy then releases them (millions of pairs, a frame's largest list).
+  virtual bool ReadsPairLists() const { return true; }
+
  protected:
   // The block's summary from its residuals r and row-major Jacobian (one column), m residuals.
   static BlockSummary Summarise(const double* residuals, const double* jacobian, int m);

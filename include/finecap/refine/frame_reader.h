@@ -4,6 +4,7 @@
 #ifndef FINECAP_REFINE_FRAME_READER_H_
 #define FINECAP_REFINE_FRAME_READER_H_
 
+#include <functional>
 #include <future>
 #include <optional>
 #include <string>
@@ -42,19 +43,28 @@ std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // Reads frames as refinement sees them (ReadFrameInput with `skip_unreadable`, the cameras named
 // in `held_out` set aside, and, given `image_options`, the images modelled) one frame ahead on a
-// thread of its own, so that reading and modelling the next frame overlap solving this one. Only
-// this reader may read images from the capture while a read is under way; at most one frame is
-// read ahead and one kept (bounded memory).
+// thread of its own, so that reading and modelling the next frame overlap solving this one; and,
+// given `work_ahead`, does that work on each frame read as well (a sequence prepares the frame's
+// energy there: PrepareFrameAhead). Only this reader may read from the capture while a read is
+// under way; at most one frame is read ahead and one kept (bounded memory).
 class FrameReadAhead {
  public:
   struct Frame {
     FrameInput input;                       // Without the held-out cameras.
     std::vector<CalibratedImage> held_out;  // TakeHeldOutViews.
     std::vector<SkippedCamera> skipped;     // Cameras whose image could not be read.
+    // Filled by `work_ahead`, when it does: the frame prepared for its solve (which takes the
+    // input's image models, and may leave the input without its images when nothing else reads
+    // them), and the true displacement of its fine vertices (a synthetic capture's ground truth).
+    PreparedFrame prepared;
+    Eigen::VectorXd true_displacement;
   };
+  // Work on frame `frame` once it is read, on the reader's thread (or the caller's, for a frame
+  // Take reads itself), with as many OpenMP threads as the thread that made the reader had.
+  using WorkAhead = std::function<void(int frame, Frame* read)>;
 
   FrameReadAhead(Capture* capture, bool skip_unreadable, std::vector<std::string> held_out,
-                 std::optional<ImageGaussianOptions> image_options);
+                 std::optional<ImageGaussianOptions> image_options, WorkAhead work_ahead = {});
 
   // Starts reading `frame` in the background, unless a read is already under way or the frame
   // is kept.
@@ -69,6 +79,9 @@ class FrameReadAhead {
   // of another frame drops it (a resumed run may never refine it).
   void Keep(int frame, Frame read);
 
+  // Waits for a read under way and drops it: before what `work_ahead` uses goes away.
+  void DropPending();
+
  private:
   Frame Read(int frame);
 
@@ -76,6 +89,8 @@ class FrameReadAhead {
   bool skip_unreadable_;
   std::vector<std::string> held_out_;
   std::optional<ImageGaussianOptions> image_options_;
+  WorkAhead work_ahead_;
+  int threads_;  // OpenMP threads for the work ahead.
   int pending_frame_ = -1;
   std::future<Frame> pending_;
   int kept_frame_ = -1;

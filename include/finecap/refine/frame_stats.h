@@ -22,7 +22,9 @@ struct FrameStats {
   int iterations = 0;
   int evaluations = 0;
   std::string termination;
-  double seconds = 0.0;              // The whole frame, reading and writing included.
+  // The frame's time on the run's thread, waiting for its read, solving and writing included; a
+  // preparation done ahead (prepared_ahead), while the frame before was solved, is not in it.
+  double seconds = 0.0;
   double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pairs.
   double seconds_solve = 0.0;
   double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
@@ -33,6 +35,8 @@ struct FrameStats {
   long pairs = 0;
   bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.
   bool kept_input = false;  // And the input surface was written instead.
+  bool prepared_ahead = false;  // PrepareFrameAhead, with the plane sweep, while another frame
+                                // was solved.
   // Against ground truth, when the capture has it (NaN otherwise): RMS of k - k_true over the
   // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
   double rms_coarse_mm = 0.0;

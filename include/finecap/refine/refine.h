@@ -183,13 +183,25 @@ struct PreparedFrame {
   Eigen::Matrix3Xd normals;             // Its unit normals, along which k displaces.
   std::vector<ImageGaussians> images;   // One per camera; the energy refers to them.
   std::unique_ptr<FrameEnergy> energy;  // Over the surface Gaussians of the refined vertices.
+  // The plane sweep's start over `energy` (SweepInitialization), when it was found ahead of the
+  // solve (PrepareFrameAhead); empty otherwise.
+  Eigen::VectorXd sweep_start;
   long num_image_gaussians = 0;
-  double seconds = 0.0;
+  double seconds = 0.0;  // The preparation's, the sweep's included.
 };
 
 // Subdivision, visibility, image Gaussians, surface Gaussians and pair lists of one frame.
 PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options);
+
+// PrepareFrame at the level RefineFrame solves last, with the plane sweep's start when that level
+// starts from it (no coarse-to-fine schedule): what RefineFrame does to a frame before it solves
+// and what does not depend on any other frame, so that a sequence can do it while the frame before
+// is solved. The prepared frame takes the input's image models (modelled now if they are not):
+// `*input` is left without them. Hand the result to RefineFrame or RefineFrameFrom with the same
+// input, colours and options.
+PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColors& colors,
+                                FrameInput* input, const RefineOptions& options);
 
 struct FrameResult {
   Mesh refined;              // The fine mesh with the displacement applied.
@@ -204,6 +216,7 @@ struct FrameResult {
   long num_image_gaussians = 0;
   long num_pairs = 0;
   double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
+  bool prepared_ahead = false;       // The configured level was prepared ahead (`ahead`).
   double seconds_total = 0.0;        // The whole frame.
 };
 
@@ -224,26 +237,27 @@ Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
 // found worse. `fine_input` is the frame's subdivided input mesh.
 void KeepInputSurface(const Mesh& fine_input, FrameResult* result);
 
-// Where a frame's solve starts: `warm_start` when given and of the right size, else the plane
-// sweep's result (zero when the sweep is off).
-Eigen::VectorXd StartingPoint(FrameEnergy* energy, const SweepOptions& sweep,
+// Where the solve of `frame` starts: `warm_start` when given and of the right size, else the
+// plane sweep's result (zero when the sweep is off), found now unless the frame carries it.
+Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,
                               const Eigen::VectorXd* warm_start);
 
 // Refines one frame, through the coarse-to-fine levels when configured. `warm_start` (may be
-// null) is a previous frame's k_solved.
+// null) is a previous frame's k_solved. `ahead`, when not empty, is PrepareFrameAhead's
+// preparation of this very frame (input, colours and options), used instead of preparing again.
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start = nullptr);
+                        const Eigen::VectorXd* warm_start = nullptr, PreparedFrame ahead = {});
 
 // RefineFrame, starting from `start`: one displacement per fine vertex, metres, as solved
 // (before bias compensation); NaN where there is none, and those vertices start where RefineFrame
 // would start them (at zero, or where the plane sweep puts them). This is how a frame is seeded
 // from another frame's saved result: a fine vertex keeps its id over the sequence, while the
 // surface Gaussians of two frames may differ. Throws Error when `start` has not one entry per
-// fine vertex.
+// fine vertex. `ahead` as for RefineFrame.
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
                             const FrameInput& input, const RefineOptions& options,
-                            const Eigen::VectorXd& start);
+                            const Eigen::VectorXd& start, PreparedFrame ahead = {});
 
 }  // namespace finecap
 
