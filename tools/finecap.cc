@@ -225,8 +225,17 @@ int Main(int argc, char** argv) {
 }  // namespace
 }  // namespace finecap
 
+namespace {
+
+// Runs before any shared library initialises, libgomp among them (PreferSleepingWorkers).
+void BeforeLibrariesInitialise(int, char**, char**) { finecap::PreferSleepingWorkers(); }
+__attribute__((section(".preinit_array"),
+               used)) void (*before_libraries_initialise)(int, char**,
+                                                          char**) = &BeforeLibrariesInitialise;
+
+}  // namespace
+
 int main(int argc, char** argv) {
-  finecap::RestartWithSleepingWorkers(argv);
   finecap::UseOneMallocArena();
   try {
     return finecap::Main(argc, argv);

@@ -2,7 +2,6 @@
 
 #include <malloc.h>
 #include <omp.h>
-#include <unistd.h>
 
 #include <cstdlib>
 
@@ -17,10 +16,9 @@ void SetWorkerThreads(int threads) {
   omp_set_num_threads(threads > 0 ? threads : default_threads);
 }
 
-void RestartWithSleepingWorkers(char** argv) {
+void PreferSleepingWorkers() {
   if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
-  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
-  execv("/proc/self/exe", argv);  // Returns only if it failed.
+  setenv("OMP_WAIT_POLICY", "passive", 1);  // On failure the workers spin, as by default.
 }
 
 void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }
