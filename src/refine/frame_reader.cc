@@ -1,6 +1,7 @@
 #include "finecap/refine/frame_reader.h"
 
 #include <algorithm>
+#include <exception>
 #include <utility>
 
 #include <omp.h>
@@ -34,17 +35,34 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
                           std::vector<SkippedCamera>* skipped) {
   FrameInput input;
   input.coarse = capture->ReadCoarseMesh(frame);
-  std::string first_error;
-  for (int c = 0; c < capture->num_cameras(); ++c) {
-    const Camera& camera = capture->cameras()[c];
+  // Each camera's images come from a source of its own, so they are decoded side by side; the
+  // failures are then taken in the rig's order, as one camera after the other would meet them.
+  const int num_cameras = capture->num_cameras();
+  std::vector<cv::Mat> images(num_cameras);
+  std::vector<std::exception_ptr> failures(num_cameras);
+  std::vector<std::string> errors(num_cameras);  // The message of a failure that is an Error.
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int c = 0; c < num_cameras; ++c) {
     try {
-      input.images.push_back(capture->ReadImage(c, frame));
-      input.cameras.push_back(camera);
+      images[c] = capture->ReadImage(c, frame);
     } catch (const Error& error) {
-      if (!skip_unreadable) throw;
-      if (first_error.empty()) first_error = error.what();
-      if (skipped != nullptr) skipped->push_back({camera.name, error.what()});
+      failures[c] = std::current_exception();
+      errors[c] = error.what();
+    } catch (...) {
+      failures[c] = std::current_exception();
     }
+  }
+  std::string first_error;
+  for (int c = 0; c < num_cameras; ++c) {
+    const Camera& camera = capture->cameras()[c];
+    if (!failures[c]) {
+      input.images.push_back(std::move(images[c]));
+      input.cameras.push_back(camera);
+      continue;
+    }
+    if (!skip_unreadable || errors[c].empty()) std::rethrow_exception(failures[c]);
+    if (first_error.empty()) first_error = errors[c];
+    if (skipped != nullptr) skipped->push_back({camera.name, errors[c]});
   }
   Require(!input.cameras.empty(), "",
           first_error + " (and no other camera's image of frame " + capture->frame_name(frame) +
@@ -123,12 +141,14 @@ FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
 FrameReadAhead::Frame FrameReadAhead::Read(int frame) {
   Frame read;
   {
-    // The images one at a time: one image's modelling buffers, not one per thread, and while
-    // the frame before is solved the solve has the cores.
-    const ScopedOpenMpThreads one(1);
+    const ScopedOpenMpThreads parallel(threads_);
     read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
     read.held_out = TakeHeldOutViews(held_out_, &read.input);
-    if (image_options_) ModelFrameImages(*image_options_, &read.input);
+  }
+  if (image_options_) {
+    // The images one at a time: one image's modelling buffers, not one per thread.
+    const ScopedOpenMpThreads one(1);
+    ModelFrameImages(*image_options_, &read.input);
   }
   if (work_ahead_) {
     // In parallel: on two cores, whichever of it and the solve ends first leaves the other both.
