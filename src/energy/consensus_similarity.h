@@ -107,6 +107,24 @@ class ConsensusSimilarity : public SimilarityTerm {
     Eigen::Vector3f color;
     Eigen::Vector3f slope;
   };
+  // The cubic Hermite interpolation at one k, apart from the table it reads: the first node of
+  // the interval holding k, and the weights of that node's colour and slope and of the next
+  // node's in the colour (`value`) and in dcolour/dk (`derivative`, zero beyond the table, where
+  // the colour stays at its end value). Every row of every camera at the same k shares them.
+  struct HermiteWeights {
+    int node = 0;
+    double value[4];
+    double derivative[4];
+  };
+  HermiteWeights HermiteAt(double k) const;
+  // weights[0] p0 + weights[1] m0 + weights[2] p1 + weights[3] m1, per channel, of the colours p
+  // and slopes m of `nodes[0]` and `nodes[1]`.
+  static void Blend(const double weights[4], const TableNode* nodes, double* color) {
+    for (int channel = 0; channel < 3; ++channel) {
+      color[channel] = weights[0] * nodes[0].color[channel] + weights[1] * nodes[0].slope[channel] +
+                       weights[2] * nodes[1].color[channel] + weights[3] * nodes[1].slope[channel];
+    }
+  }
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
   // The nodes of one row of `view`'s pair list: ImageColorOfPairs over the image Gaussians in
@@ -114,20 +132,22 @@ class ConsensusSimilarity : public SimilarityTerm {
   // once per node.
   void TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
                    TableNode* nodes) const;
-  // Colours of every row of every camera's pair list at one k, [c][row].
-  using RowColors = std::vector<std::vector<Eigen::Vector3d>>;
-  // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
-  // member displaced by k along its own normal, interpolated in the tables; or, given
-  // `row_colors` (taken at this k, flat patches), read from them.
-  void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                   std::vector<Eigen::Vector3d>* derivatives,
-                   const RowColors* row_colors = nullptr) const;
+  // Number of members of block b's patch (centre first).
+  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
+  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
+  // The colours of block b's patch in each of its cameras with every member displaced by k along
+  // its own normal (and the patch's shape), interpolated in the tables, and, when `derivatives`
+  // is not null, their k-derivatives; or, given `row_colors` (every table row's colour at this
+  // k, flat patches), read from them. Written camera after camera, member after member, channel
+  // after channel: the order of the block's residuals.
+  void PatchColors(int b, double k, double* colors, double* derivatives,
+                   const Eigen::Vector3d* row_colors = nullptr) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
   // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
   // their derivatives.
   void BlockAt(int b, double k, double* residuals, double* jacobian,
-               const RowColors* row_colors = nullptr) const;
+               const Eigen::Vector3d* row_colors = nullptr) const;
 
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
@@ -137,18 +157,25 @@ class ConsensusSimilarity : public SimilarityTerm {
   double scale_;  // 1 / sqrt(n_c).
 
   std::vector<ResidualBlock> blocks_;  // One per patch; its parameter: the centre's k.
-  // Block b's cameras are cameras_[camera_begin_[b] ..); rows_[a] (same index a) holds, for each
-  // patch member (centre first), its row in that camera's pair list.
-  std::vector<int> camera_begin_;
-  std::vector<int> cameras_;
-  std::vector<std::vector<int>> rows_;
+  // Block b's patch members (surface Gaussians, centre first) are
+  // members_[patch_begin_[b] ..), and its cameras cameras_[camera_begin_[b] ..). For each of
+  // those cameras in turn, rows_ (from row_begin_[b]) holds every member's table row: its row in
+  // that camera's pair list plus the camera's first_row_.
+  std::vector<int> patch_begin_, members_;
+  std::vector<int> camera_begin_, cameras_;
+  std::vector<long> row_begin_;
+  std::vector<int> rows_;
   std::vector<Eigen::Vector3d> weights_;
 
-  // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
+  // Node g of the tables is at k = node_k0_ + g * node_step_. All cameras' rows in one table:
+  // camera c's pair-list row `row` is table row first_row_[c] + row, its node g at
+  // table_[(first_row_[c] + row) * num_nodes_ + g].
   double node_k0_ = 0.0, node_step_ = 1.0;
   int num_nodes_ = 0;
-  std::vector<std::vector<TableNode>> table_;
+  std::vector<int> first_row_;
+  std::vector<TableNode> table_;
   Eigen::VectorXd shape_;
+  std::vector<Eigen::Vector3d> row_colors_;  // BlockCosts' colour of every table row.
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_;
