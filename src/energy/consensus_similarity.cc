@@ -83,11 +83,30 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
   }
 }
 
-// Scales a block's residuals r (and their derivatives dr/dk, when given) so that their sum of
-// squares becomes rho(|r|^2) = c2 log(1 + |r|^2 / c2), Cauchy's loss: a block that disagrees far
-// more than c2 stops pulling its Gaussian harder, and the regulariser carries its neighbours'
-// displacement into it. r' = alpha r with alpha = sqrt(rho(s) / s), s = |r|^2, and
-// dr'/dk = alpha dr/dk + r (d alpha / ds) 2 <r, dr/dk>.
+// Cauchy's loss rho(s) = c2 log(1 + s / c2) of a block's sum of squares s = |r|^2 as a scaling of
+// its residuals r' = alpha r, alpha = sqrt(rho(s) / s), so that |r'|^2 = rho(s): a block that
+// disagrees far more than c2 stops pulling its Gaussian harder, and the regulariser carries its
+// neighbours' displacement into it. Then dr'/dk = alpha dr/dk + r (d alpha / ds) ds/dk.
+struct CauchyScaling {
+  double alpha = 1.0, dalpha_ds = 0.0;
+
+  CauchyScaling(double c2, double s) {
+    const double u = s / c2;
+    // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
+    if (u < 1e-6) {
+      alpha = 1.0 - 0.25 * u;
+      dalpha_ds = -0.25 / c2;
+    } else {
+      const double rho = c2 * std::log1p(u);
+      const double drho = 1.0 / (1.0 + u);
+      alpha = std::sqrt(rho / s);
+      dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
+    }
+  }
+};
+
+// Scales a block's residuals r (and their derivatives dr/dk, when given) by Cauchy's loss of
+// scale c2 (none when c2 <= 0).
 void Robustify(double c2, int num_residuals, double* residuals, double* jacobian) {
   if (c2 <= 0.0) return;
   double s = 0.0, ds = 0.0;
@@ -95,22 +114,36 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
     s += residuals[r] * residuals[r];
     if (jacobian != nullptr) ds += 2.0 * residuals[r] * jacobian[r];
   }
-  const double u = s / c2;
-  // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
-  double alpha, dalpha_ds;
-  if (u < 1e-6) {
-    alpha = 1.0 - 0.25 * u;
-    dalpha_ds = -0.25 / c2;
-  } else {
-    const double rho = c2 * std::log1p(u);
-    const double drho = 1.0 / (1.0 + u);
-    alpha = std::sqrt(rho / s);
-    dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
-  }
+  const CauchyScaling scaling(c2, s);
   for (int r = 0; r < num_residuals; ++r) {
-    if (jacobian != nullptr) jacobian[r] = alpha * jacobian[r] + residuals[r] * dalpha_ds * ds;
-    residuals[r] *= alpha;
+    if (jacobian != nullptr) {
+      jacobian[r] = scaling.alpha * jacobian[r] + residuals[r] * scaling.dalpha_ds * ds;
+    }
+    residuals[r] *= scaling.alpha;
   }
+}
+
+// The summary of a block's residuals r' after Robustify from that of r before it, without
+// either: with s = |r|^2, g = <r, dr/dk>, h = |dr/dk|^2 and a' = d alpha / dk = (d alpha / ds) 2g,
+// |r'|^2 = alpha^2 s, <r', dr'/dk> = alpha^2 g + alpha a' s and
+// |dr'/dk|^2 = alpha^2 h + 2 alpha a' g + a'^2 s.
+// Without derivatives |r'|^2 = rho(s) alone, without alpha's square root and divisions.
+SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSummary& plain,
+                                       bool with_derivatives) {
+  if (c2 <= 0.0) return plain;
+  if (!with_derivatives && plain.squared_norm >= 1e-6 * c2) {
+    SimilarityTerm::BlockSummary robust;
+    robust.squared_norm = c2 * std::log1p(plain.squared_norm / c2);
+    return robust;
+  }
+  const CauchyScaling scaling(c2, plain.squared_norm);
+  const double alpha = scaling.alpha, dalpha_dk = scaling.dalpha_ds * 2.0 * plain.gradient;
+  SimilarityTerm::BlockSummary robust;
+  robust.squared_norm = alpha * alpha * plain.squared_norm;
+  robust.gradient = alpha * alpha * plain.gradient + alpha * dalpha_dk * plain.squared_norm;
+  robust.curvature = alpha * alpha * plain.curvature + 2.0 * alpha * dalpha_dk * plain.gradient +
+                     dalpha_dk * dalpha_dk * plain.squared_norm;
+  return robust;
 }
 
 }  // namespace
@@ -331,8 +364,10 @@ void ConsensusSimilarity::PatchColors(int b, double k, double* colors, double* d
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   const int* rows = &rows_[row_begin_[b]];
   if (row_colors != nullptr) {
-    for (int i = 0; i < num_cameras * n; ++i)
-      std::copy_n(row_colors[rows[i]].data(), 3, colors + 3 * i);
+    for (int i = 0; i < num_cameras * n; ++i) {
+      const Eigen::Vector3d& color = row_colors[rows[i]];
+      colors[3 * i] = color[0], colors[3 * i + 1] = color[1], colors[3 * i + 2] = color[2];
+    }
     return;
   }
   // A member's k, and so its node interval and Hermite weights, is the same in every camera:
@@ -371,8 +406,8 @@ Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
   return (variance / num_cameras).cwiseSqrt();
 }
 
-void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian,
-                                  const Eigen::Vector3d* row_colors) const {
+void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals, double* jacobian,
+                                         const Eigen::Vector3d* row_colors) const {
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   // The colours become the residuals in place: normalised per camera, then each against the
   // cameras' mean.
@@ -400,35 +435,48 @@ void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* ja
     against_mean(residuals, m);
     if (jacobian != nullptr) against_mean(jacobian, m);
   }
-  if (options_.robust_fraction > 0.0) {
-    // The level of disagreement of unrelated patches: each normalised channel has unit
-    // variance, so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
-    const double unrelated = 3.0 * n * (num_cameras - 1) * weight.squaredNorm() / 3.0;
-    Robustify(options_.robust_fraction * unrelated, blocks_[b].num_residuals, residuals, jacobian);
+}
+
+double ConsensusSimilarity::LossScale(int b) const {
+  // The level of disagreement of unrelated patches: each normalised channel has unit variance,
+  // so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
+  const double unrelated =
+      3.0 * PatchSize(b) * (NumCameras(b) - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
+  return options_.robust_fraction * unrelated;
+}
+
+void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
+  PlainResiduals(b, k, residuals, jacobian);
+  Robustify(LossScale(b), blocks_[b].num_residuals, residuals, jacobian);
+}
+
+SimilarityTerm::BlockSummary ConsensusSimilarity::SummaryAt(
+    int b, double k, bool with_derivatives, const Eigen::Vector3d* row_colors) const {
+  thread_local std::vector<double> residuals, jacobian;
+  const int num_residuals = blocks_[b].num_residuals;
+  residuals.resize(num_residuals);
+  jacobian.resize(with_derivatives ? num_residuals : 0);
+  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr, row_colors);
+  BlockSummary plain;
+  if (with_derivatives) {
+    plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
+  } else {
+    for (int r = 0; r < num_residuals; ++r) plain.squared_norm += residuals[r] * residuals[r];
   }
+  return Robustify(LossScale(b), plain, with_derivatives);
 }
 
 double ConsensusSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {
   if (gradient != nullptr) *gradient = Eigen::VectorXd::Zero(k.size());
   const int num_blocks = static_cast<int>(blocks_.size());
   double sum_of_squares = 0.0;
-#pragma omp parallel reduction(+ : sum_of_squares)
-  {
-    std::vector<double> residuals, jacobian;
-#pragma omp for schedule(dynamic, 64)
-    for (int b = 0; b < num_blocks; ++b) {
-      const int s = blocks_[b].parameters[0];
-      residuals.resize(blocks_[b].num_residuals);
-      jacobian.resize(residuals.size());
-      BlockAt(b, k[s], residuals.data(), gradient != nullptr ? jacobian.data() : nullptr);
-      double dcost = 0.0;
-      for (size_t r = 0; r < residuals.size(); ++r) {
-        sum_of_squares += residuals[r] * residuals[r];
-        if (gradient != nullptr) dcost += residuals[r] * jacobian[r];
-      }
-      // Each block owns one parameter: no two threads write the same entry.
-      if (gradient != nullptr) (*gradient)[s] = -dcost;
-    }
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : sum_of_squares)
+  for (int b = 0; b < num_blocks; ++b) {
+    const int s = blocks_[b].parameters[0];
+    const BlockSummary summary = SummaryAt(b, k[s], gradient != nullptr);
+    sum_of_squares += summary.squared_norm;
+    // Each block owns one parameter: no two threads write the same entry.
+    if (gradient != nullptr) (*gradient)[s] = -summary.gradient;
   }
   return -0.5 * sum_of_squares;
 }
@@ -447,31 +495,27 @@ void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_j
 void ConsensusSimilarity::PrepareBlockSummaries(const Eigen::VectorXd& k) {
   const int num_blocks = static_cast<int>(blocks_.size());
   summaries_.resize(num_blocks);
-#pragma omp parallel
-  {
-    std::vector<double> residuals, jacobian;
-#pragma omp for schedule(dynamic, 64)
-    for (int b = 0; b < num_blocks; ++b) {
-      residuals.resize(blocks_[b].num_residuals);
-      jacobian.resize(residuals.size());
-      BlockAt(b, k[blocks_[b].parameters[0]], residuals.data(), jacobian.data());
-      summaries_[b] = Summarise(residuals.data(), jacobian.data(), blocks_[b].num_residuals);
-    }
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    summaries_[b] = SummaryAt(b, k[blocks_[b].parameters[0]], true);
   }
 }
 
 void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  costs->resize(num_blocks);
   const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
   if (!uniform) {
-    SimilarityTerm::BlockCosts(k, costs);
+#pragma omp parallel for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
+    }
     return;
   }
   // Every row at the same k: one set of Hermite weights for all.
   const HermiteWeights weights = HermiteAt(k[0]);
   const int num_rows = first_row_.back();
   row_colors_.resize(num_rows);
-  const int num_blocks = static_cast<int>(blocks_.size());
-  costs->resize(num_blocks);
   // One parallel region for both loops: on a busy machine each region's start and barrier can
   // wait a time slice for a thread, and the sweep calls this for every sample.
 #pragma omp parallel
@@ -480,14 +524,9 @@ void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<doubl
     for (int row = 0; row < num_rows; ++row) {
       Blend(weights.value, &table_[long(row) * num_nodes_ + weights.node], row_colors_[row].data());
     }
-    std::vector<double> residuals;
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
-      residuals.resize(blocks_[b].num_residuals);
-      BlockAt(b, k[0], residuals.data(), nullptr, row_colors_.data());
-      double cost = 0.0;
-      for (double r : residuals) cost += r * r;
-      (*costs)[b] = cost;
+      (*costs)[b] = SummaryAt(b, k[0], false, row_colors_.data()).squared_norm;
     }
   }
 }

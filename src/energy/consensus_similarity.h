@@ -32,9 +32,13 @@
 // p_jc(k) is tabulated once per frame, with its derivative, at displacements sigma_hat / 2 apart
 // over [-k_max, k_max], and read between them by cubic Hermite interpolation (exact at the nodes,
 // C1 between them). The energy the solvers see is the interpolated one, and its Jacobians are
-// those of the interpolant, exactly. At a node, only the image Gaussians within `reach_sigmas`
-// combined standard deviations of the projected Gaussian there count (as ImageColorAround counts
-// them): the row's pair list covers its whole path over [-k_max, k_max].
+// those of the interpolant, exactly. A member's k, and so its node interval and Hermite weights,
+// is the same in every camera of the patch: they are computed once per member, and each camera
+// only reads its two nodes. What the solvers and the sweep need of a block is its sum of squares,
+// gradient and curvature: the robust loss is applied to those sums, and the robust residuals
+// themselves are written only for PrepareResiduals. At a node, only the image Gaussians within
+// `reach_sigmas` combined standard deviations of the projected Gaussian there count (as
+// ImageColorAround counts them): the row's pair list covers its whole path over [-k_max, k_max].
 //
 // Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
 // patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
@@ -66,12 +70,14 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
-  // Each block's summary straight from its residuals, without storing them (a frame's ~0.8 M
-  // residuals and as many derivatives, written and read back at every evaluation otherwise).
+  // Each block's summary straight from its residuals before the robust loss, without storing
+  // them (a frame's ~0.8 M residuals and as many derivatives, written and read back at every
+  // evaluation otherwise), the loss applied to the sums.
   void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
   bool IsLeastSquares() const override { return true; }
-  // Where every k_s is the same and the patches are flat (the plane sweep's samples), each
-  // pair-list row's colour is interpolated once instead of once for every patch it belongs to.
+  // Each block's sum of squares without storing its residuals. Where every k_s is the same and
+  // the patches are flat (the plane sweep's samples), each pair-list row's colour is interpolated
+  // once instead of once for every patch it belongs to.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
 
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
@@ -144,10 +150,18 @@ class ConsensusSimilarity : public SimilarityTerm {
                    const Eigen::Vector3d* row_colors = nullptr) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
-  // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
-  // their derivatives.
-  void BlockAt(int b, double k, double* residuals, double* jacobian,
-               const Eigen::Vector3d* row_colors = nullptr) const;
+  // The residuals of block b at displacement k of its patch before the robust loss, and, when
+  // `jacobian` is not null, their derivatives; `row_colors` as for PatchColors.
+  void PlainResiduals(int b, double k, double* residuals, double* jacobian,
+                      const Eigen::Vector3d* row_colors = nullptr) const;
+  // The scale c2 of block b's robust loss (none when not positive).
+  double LossScale(int b) const;
+  // Block b's residuals, and their derivatives when `jacobian` is not null.
+  void BlockAt(int b, double k, double* residuals, double* jacobian) const;
+  // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
+  // applied to the sums instead of to every residual: what the solvers and the sweep need.
+  BlockSummary SummaryAt(int b, double k, bool with_derivatives,
+                         const Eigen::Vector3d* row_colors = nullptr) const;
 
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
