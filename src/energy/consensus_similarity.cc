@@ -31,45 +31,82 @@ std::vector<int> RowsOf(const CameraPairs& pairs, int num_surface) {
   return rows;
 }
 
-// The colours q of a patch in one camera, normalised, z_m = (q_m - mean) / deviation with
-// deviation = sqrt(variance + floor^2), the mean per channel and the variance per channel or, when
-// `pooled`, over all three channels (one gain for the camera); and, when `dq` is given, dz/dk from
-// dq/dk: dz_m/dk = (dq_m/dk - mean dq/dk - z_m <z, dq/dk>) / deviation, where <z, dq/dk> is the
-// mean over the patch (and the channels, when pooled) of z_j dq_j/dk.
-void Normalise(const std::vector<Eigen::Vector3d>& q, const std::vector<Eigen::Vector3d>* dq,
-               double floor, bool pooled, std::vector<Eigen::Vector3d>* z,
-               std::vector<Eigen::Vector3d>* dz) {
-  const int n = static_cast<int>(q.size());
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& value : q) mean += value;
-  mean /= n;
-  Eigen::Array3d variance = Eigen::Array3d::Zero();
-  for (const Eigen::Vector3d& value : q) variance += (value - mean).array().square();
-  variance /= n;
-  if (pooled) variance.setConstant(variance.mean());
-  const Eigen::Array3d inverse_deviation = (variance + floor * floor).sqrt().inverse();
-  z->resize(n);
-  for (int m = 0; m < n; ++m) (*z)[m] = ((q[m] - mean).array() * inverse_deviation).matrix();
-  if (dq == nullptr) return;
-  Eigen::Array3d mean_derivative = Eigen::Array3d::Zero(), z_dot_dq = Eigen::Array3d::Zero();
-  for (int j = 0; j < n; ++j) {
-    mean_derivative += (*dq)[j].array() / n;
-    z_dot_dq += (*z)[j].array() * (*dq)[j].array() / n;
-  }
-  if (pooled) z_dot_dq.setConstant(z_dot_dq.mean());
-  dz->resize(n);
+// Normalises, in place, the colours q of a patch in one camera (n members of three channels):
+// z_m = (q_m - mean) / deviation with deviation = sqrt(variance + floor^2), the mean per channel
+// and the variance per channel or, when `pooled`, over all three channels (one gain for the
+// camera); and, when `dq` is not null, turns dq/dk into dz/dk:
+// dz_m/dk = (dq_m/dk - mean dq/dk - z_m <z, dq/dk>) / deviation, where <z, dq/dk> is the mean
+// over the patch (and the channels, when pooled) of z_j dq_j/dk.
+void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
+  double mean[3] = {0.0, 0.0, 0.0}, variance[3] = {0.0, 0.0, 0.0};
   for (int m = 0; m < n; ++m) {
-    (*dz)[m] =
-        (((*dq)[m].array() - mean_derivative - (*z)[m].array() * z_dot_dq) * inverse_deviation)
-            .matrix();
+    for (int channel = 0; channel < 3; ++channel) mean[channel] += q[3 * m + channel];
+  }
+  for (double& value : mean) value /= n;
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      const double difference = q[3 * m + channel] - mean[channel];
+      variance[channel] += difference * difference;
+    }
+  }
+  for (double& value : variance) value /= n;
+  if (pooled) std::fill_n(variance, 3, (variance[0] + variance[1] + variance[2]) / 3.0);
+  double inverse_deviation[3];
+  for (int channel = 0; channel < 3; ++channel) {
+    inverse_deviation[channel] = 1.0 / std::sqrt(variance[channel] + floor * floor);
+  }
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      q[3 * m + channel] = (q[3 * m + channel] - mean[channel]) * inverse_deviation[channel];
+    }
+  }
+  if (dq == nullptr) return;
+  double mean_derivative[3] = {0.0, 0.0, 0.0}, z_dot_dq[3] = {0.0, 0.0, 0.0};
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      mean_derivative[channel] += dq[3 * m + channel];
+      z_dot_dq[channel] += q[3 * m + channel] * dq[3 * m + channel];
+    }
+  }
+  for (int channel = 0; channel < 3; ++channel) {
+    mean_derivative[channel] /= n;
+    z_dot_dq[channel] /= n;
+  }
+  if (pooled) std::fill_n(z_dot_dq, 3, (z_dot_dq[0] + z_dot_dq[1] + z_dot_dq[2]) / 3.0);
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      double& derivative = dq[3 * m + channel];
+      derivative =
+          (derivative - mean_derivative[channel] - q[3 * m + channel] * z_dot_dq[channel]) *
+          inverse_deviation[channel];
+    }
   }
 }
 
-// Scales a block's residuals r (and their derivatives dr/dk, when given) so that their sum of
-// squares becomes rho(|r|^2) = c2 log(1 + |r|^2 / c2), Cauchy's loss: a block that disagrees far
-// more than c2 stops pulling its Gaussian harder, and the regulariser carries its neighbours'
-// displacement into it. r' = alpha r with alpha = sqrt(rho(s) / s), s = |r|^2, and
-// dr'/dk = alpha dr/dk + r (d alpha / ds) 2 <r, dr/dk>.
+// Cauchy's loss rho(s) = c2 log(1 + s / c2) of a block's sum of squares s = |r|^2 as a scaling of
+// its residuals r' = alpha r, alpha = sqrt(rho(s) / s), so that |r'|^2 = rho(s): a block that
+// disagrees far more than c2 stops pulling its Gaussian harder, and the regulariser carries its
+// neighbours' displacement into it. Then dr'/dk = alpha dr/dk + r (d alpha / ds) ds/dk.
+struct CauchyScaling {
+  double alpha = 1.0, dalpha_ds = 0.0;
+
+  CauchyScaling(double c2, double s) {
+    const double u = s / c2;
+    // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
+    if (u < 1e-6) {
+      alpha = 1.0 - 0.25 * u;
+      dalpha_ds = -0.25 / c2;
+    } else {
+      const double rho = c2 * std::log1p(u);
+      const double drho = 1.0 / (1.0 + u);
+      alpha = std::sqrt(rho / s);
+      dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
+    }
+  }
+};
+
+// Scales a block's residuals r (and their derivatives dr/dk, when given) by Cauchy's loss of
+// scale c2 (none when c2 <= 0).
 void Robustify(double c2, int num_residuals, double* residuals, double* jacobian) {
   if (c2 <= 0.0) return;
   double s = 0.0, ds = 0.0;
@@ -77,22 +114,36 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
     s += residuals[r] * residuals[r];
     if (jacobian != nullptr) ds += 2.0 * residuals[r] * jacobian[r];
   }
-  const double u = s / c2;
-  // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
-  double alpha, dalpha_ds;
-  if (u < 1e-6) {
-    alpha = 1.0 - 0.25 * u;
-    dalpha_ds = -0.25 / c2;
-  } else {
-    const double rho = c2 * std::log1p(u);
-    const double drho = 1.0 / (1.0 + u);
-    alpha = std::sqrt(rho / s);
-    dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
-  }
+  const CauchyScaling scaling(c2, s);
   for (int r = 0; r < num_residuals; ++r) {
-    if (jacobian != nullptr) jacobian[r] = alpha * jacobian[r] + residuals[r] * dalpha_ds * ds;
-    residuals[r] *= alpha;
+    if (jacobian != nullptr) {
+      jacobian[r] = scaling.alpha * jacobian[r] + residuals[r] * scaling.dalpha_ds * ds;
+    }
+    residuals[r] *= scaling.alpha;
   }
+}
+
+// The summary of a block's residuals r' after Robustify from that of r before it, without
+// either: with s = |r|^2, g = <r, dr/dk>, h = |dr/dk|^2 and a' = d alpha / dk = (d alpha / ds) 2g,
+// |r'|^2 = alpha^2 s, <r', dr'/dk> = alpha^2 g + alpha a' s and
+// |dr'/dk|^2 = alpha^2 h + 2 alpha a' g + a'^2 s.
+// Without derivatives |r'|^2 = rho(s) alone, without alpha's square root and divisions.
+SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSummary& plain,
+                                       bool with_derivatives) {
+  if (c2 <= 0.0) return plain;
+  if (!with_derivatives && plain.squared_norm >= 1e-6 * c2) {
+    SimilarityTerm::BlockSummary robust;
+    robust.squared_norm = c2 * std::log1p(plain.squared_norm / c2);
+    return robust;
+  }
+  const CauchyScaling scaling(c2, plain.squared_norm);
+  const double alpha = scaling.alpha, dalpha_dk = scaling.dalpha_ds * 2.0 * plain.gradient;
+  SimilarityTerm::BlockSummary robust;
+  robust.squared_norm = alpha * alpha * plain.squared_norm;
+  robust.gradient = alpha * alpha * plain.gradient + alpha * dalpha_dk * plain.squared_norm;
+  robust.curvature = alpha * alpha * plain.curvature + 2.0 * alpha * dalpha_dk * plain.gradient +
+                     dalpha_dk * dalpha_dk * plain.squared_norm;
+  return robust;
 }
 
 }  // namespace
@@ -111,28 +162,35 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
   options_.Check();
   Require(one_rings.size() == static_cast<size_t>(surface.size()), "consensus similarity",
           "one neighbour list per surface Gaussian expected");
+  first_row_.assign(1, 0);
   std::vector<std::vector<int>> rows_of(views.size());
-  for (size_t c = 0; c < views.size(); ++c) rows_of[c] = RowsOf(views[c].pairs, surface.size());
+  for (size_t c = 0; c < views.size(); ++c) {
+    rows_of[c] = RowsOf(views[c].pairs, surface.size());
+    first_row_.push_back(first_row_.back() + static_cast<int>(views[c].pairs.surface_ids.size()));
+  }
 
+  row_begin_.push_back(0);
   for (int s = 0; s < surface.size(); ++s) {
     if (static_cast<int>(one_rings[s].size()) < kMinPatchNeighbours) continue;
     std::vector<int> patch = {s};
     patch.insert(patch.end(), one_rings[s].begin(), one_rings[s].end());
-    std::vector<int> cameras;
-    std::vector<std::vector<int>> rows;
+    std::vector<int> cameras, rows;
     for (size_t c = 0; c < views.size(); ++c) {
-      std::vector<int> patch_rows;
-      for (int j : patch) patch_rows.push_back(rows_of[c][j]);
-      if (std::find(patch_rows.begin(), patch_rows.end(), -1) != patch_rows.end()) continue;
+      const auto unseen = [&](int j) { return rows_of[c][j] < 0; };
+      if (std::any_of(patch.begin(), patch.end(), unseen)) continue;
       cameras.push_back(static_cast<int>(c));
-      rows.push_back(std::move(patch_rows));
+      for (int j : patch) rows.push_back(first_row_[c] + rows_of[c][j]);
     }
     if (static_cast<int>(cameras.size()) < options_.min_cameras) continue;
+    patch_begin_.push_back(static_cast<int>(members_.size()));
+    members_.insert(members_.end(), patch.begin(), patch.end());
     camera_begin_.push_back(static_cast<int>(cameras_.size()));
     cameras_.insert(cameras_.end(), cameras.begin(), cameras.end());
-    for (auto& patch_rows : rows) rows_.push_back(std::move(patch_rows));
-    blocks_.push_back({{s}, 3 * static_cast<int>(cameras.size() * patch.size())});
+    rows_.insert(rows_.end(), rows.begin(), rows.end());
+    row_begin_.push_back(static_cast<long>(rows_.size()));
+    blocks_.push_back({{s}, 3 * static_cast<int>(rows.size())});
   }
+  patch_begin_.push_back(static_cast<int>(members_.size()));
   camera_begin_.push_back(static_cast<int>(cameras_.size()));
 
   residual_begin_.assign(1, 0);
@@ -154,16 +212,15 @@ void ConsensusSimilarity::BuildTables(double k_max) {
   num_nodes_ = NumTableNodes(surface_.sigma_hat, k_max);
   node_step_ = 2.0 * k_max / (num_nodes_ - 1);
   node_k0_ = -k_max;
-  table_.resize(views_.size());
+  table_.resize(long(first_row_.back()) * num_nodes_);
   for (size_t c = 0; c < views_.size(); ++c) {
     const int num_rows = static_cast<int>(views_[c].pairs.surface_ids.size());
-    table_[c].resize(long(num_rows) * num_nodes_);
 #pragma omp parallel
     {
       RowImageGaussians paired;
 #pragma omp for schedule(dynamic, 16)
       for (int row = 0; row < num_rows; ++row) {
-        TabulateRow(views_[c], row, &paired, &table_[c][long(row) * num_nodes_]);
+        TabulateRow(views_[c], row, &paired, &table_[(long(first_row_[c]) + row) * num_nodes_]);
       }
     }
   }
@@ -273,49 +330,61 @@ void ConsensusSimilarity::TabulateRow(const EnergyView& view, int row, RowImageG
   }
 }
 
-void ConsensusSimilarity::PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                                      std::vector<Eigen::Vector3d>* derivatives,
-                                      const RowColors* row_colors) const {
-  const int c = cameras_[a];
-  const std::vector<int>& rows = rows_[a];
-  const int n = static_cast<int>(rows.size());
-  colors->resize(n);
-  if (row_colors != nullptr) {
-    for (int m = 0; m < n; ++m) (*colors)[m] = (*row_colors)[c][rows[m]];
-    return;
-  }
-  if (derivatives != nullptr) derivatives->resize(n);
-  const EnergyView& view = views_[c];
-  const double centre_shape = shape_[view.pairs.surface_ids[rows[0]]];
-  for (int m = 0; m < n; ++m) {
-    const double member_k = k + shape_[view.pairs.surface_ids[rows[m]]] - centre_shape;
-    (*colors)[m] = Interpolate(c, rows[m], member_k, derivatives ? &(*derivatives)[m] : nullptr);
-  }
+ConsensusSimilarity::HermiteWeights ConsensusSimilarity::HermiteAt(double k) const {
+  // Beyond the table the colour stays at its end value.
+  const double x = std::clamp((k - node_k0_) / node_step_, 0.0, num_nodes_ - 1.0);
+  HermiteWeights weights;
+  weights.node = std::min(static_cast<int>(x), num_nodes_ - 2);
+  const double t = x - weights.node, t2 = t * t, t3 = t2 * t;
+  weights.value[0] = 2 * t3 - 3 * t2 + 1;
+  weights.value[1] = t3 - 2 * t2 + t;
+  weights.value[2] = -2 * t3 + 3 * t2;
+  weights.value[3] = t3 - t2;
+  const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
+  const double per_step = inside ? 1.0 / node_step_ : 0.0;
+  weights.derivative[0] = (6 * t2 - 6 * t) * per_step;
+  weights.derivative[1] = (3 * t2 - 4 * t + 1) * per_step;
+  weights.derivative[2] = (-6 * t2 + 6 * t) * per_step;
+  weights.derivative[3] = (3 * t2 - 2 * t) * per_step;
+  return weights;
 }
 
 Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
                                                  Eigen::Vector3d* derivative) const {
-  // Cubic Hermite basis on the node interval holding k; beyond the table the colour stays at
-  // its end value.
-  const double x = std::clamp((k - node_k0_) / node_step_, 0.0, num_nodes_ - 1.0);
-  const int g = std::min(static_cast<int>(x), num_nodes_ - 2);
-  const double t = x - g, t2 = t * t, t3 = t2 * t;
-  const TableNode* node = &table_[c][long(row) * num_nodes_ + g];
-  const Eigen::Vector3d p0 = node[0].color.cast<double>();
-  const Eigen::Vector3d p1 = node[1].color.cast<double>();
-  const Eigen::Vector3d m0 = node[0].slope.cast<double>();
-  const Eigen::Vector3d m1 = node[1].slope.cast<double>();
-  if (derivative != nullptr) {
-    const bool inside = k > node_k0_ && k < node_k0_ + (num_nodes_ - 1) * node_step_;
-    derivative->setZero();
-    if (inside) {
-      *derivative = ((6 * t2 - 6 * t) * p0 + (3 * t2 - 4 * t + 1) * m0 + (-6 * t2 + 6 * t) * p1 +
-                     (3 * t2 - 2 * t) * m1) /
-                    node_step_;
+  const HermiteWeights weights = HermiteAt(k);
+  const TableNode* nodes = &table_[(long(first_row_[c]) + row) * num_nodes_ + weights.node];
+  Eigen::Vector3d color;
+  Blend(weights.value, nodes, color.data());
+  if (derivative != nullptr) Blend(weights.derivative, nodes, derivative->data());
+  return color;
+}
+
+void ConsensusSimilarity::PatchColors(int b, double k, double* colors, double* derivatives,
+                                      const Eigen::Vector3d* row_colors) const {
+  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  const int* rows = &rows_[row_begin_[b]];
+  if (row_colors != nullptr) {
+    for (int i = 0; i < num_cameras * n; ++i) {
+      const Eigen::Vector3d& color = row_colors[rows[i]];
+      colors[3 * i] = color[0], colors[3 * i + 1] = color[1], colors[3 * i + 2] = color[2];
+    }
+    return;
+  }
+  // A member's k, and so its node interval and Hermite weights, is the same in every camera:
+  // each camera only reads its two nodes.
+  thread_local std::vector<HermiteWeights> weights;
+  weights.resize(n);
+  const int* members = &members_[patch_begin_[b]];
+  const double centre_shape = shape_[members[0]];
+  for (int m = 0; m < n; ++m) weights[m] = HermiteAt(k + shape_[members[m]] - centre_shape);
+  for (int a = 0; a < num_cameras; ++a) {
+    for (int m = 0; m < n; ++m) {
+      const int i = a * n + m;
+      const TableNode* nodes = &table_[long(rows[i]) * num_nodes_ + weights[m].node];
+      Blend(weights[m].value, nodes, colors + 3 * i);
+      if (derivatives != nullptr) Blend(weights[m].derivative, nodes, derivatives + 3 * i);
     }
   }
-  return (2 * t3 - 3 * t2 + 1) * p0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * p1 +
-         (t3 - t2) * m1;
 }
 
 void ConsensusSimilarity::SetPatchShape(const Eigen::VectorXd& shape) {
@@ -325,78 +394,89 @@ void ConsensusSimilarity::SetPatchShape(const Eigen::VectorXd& shape) {
 }
 
 Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
+  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  std::vector<double> colors(3 * n * num_cameras);
+  PatchColors(b, 0.0, colors.data(), nullptr);
   Eigen::Vector3d variance = Eigen::Vector3d::Zero();
-  std::vector<Eigen::Vector3d> colors;
-  for (int a = camera_begin_[b]; a < camera_begin_[b + 1]; ++a) {
-    PatchColors(a, 0.0, &colors, nullptr);
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& color : colors) mean += color / colors.size();
-    for (const Eigen::Vector3d& color : colors)
-      variance += (color - mean).cwiseAbs2() / colors.size();
+  for (int a = 0; a < num_cameras; ++a) {
+    const Eigen::Map<const Eigen::Matrix3Xd> camera_colors(&colors[3 * n * a], 3, n);
+    const Eigen::Vector3d mean = camera_colors.rowwise().mean();
+    variance += (camera_colors.colwise() - mean).cwiseAbs2().rowwise().mean();
   }
-  return (variance / (camera_begin_[b + 1] - camera_begin_[b])).cwiseSqrt();
+  return (variance / num_cameras).cwiseSqrt();
 }
 
-void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian,
-                                  const RowColors* row_colors) const {
-  const int num_cameras = camera_begin_[b + 1] - camera_begin_[b];
-  // Each thread keeps its buffers from block to block: a frame's sweep and solve call this ~10^6
-  // times, and allocating them each time cost ~2 % of the frame's work.
-  thread_local std::vector<std::vector<Eigen::Vector3d>> z, dz;
-  thread_local std::vector<Eigen::Vector3d> q, dq;
-  z.resize(num_cameras);
-  dz.resize(num_cameras);
+void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals, double* jacobian,
+                                         const Eigen::Vector3d* row_colors) const {
+  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  // The colours become the residuals in place: normalised per camera, then each against the
+  // cameras' mean.
+  PatchColors(b, k, residuals, jacobian, row_colors);
+  const int stride = 3 * n;  // From one camera's patch to the next.
   for (int a = 0; a < num_cameras; ++a) {
-    PatchColors(camera_begin_[b] + a, k, &q, jacobian != nullptr ? &dq : nullptr, row_colors);
-    Normalise(q, jacobian != nullptr ? &dq : nullptr, options_.contrast_floor,
-              !options_.gain_per_channel, &z[a], &dz[a]);
+    Normalise(n, options_.contrast_floor, !options_.gain_per_channel, residuals + stride * a,
+              jacobian != nullptr ? jacobian + stride * a : nullptr);
   }
-  const int n = static_cast<int>(z[0].size());
   const Eigen::Vector3d weight = scale_ * weights_[b];
+  const auto against_mean = [&](double* values, int m) {
+    double mean[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < num_cameras; ++a) {
+      for (int channel = 0; channel < 3; ++channel)
+        mean[channel] += values[stride * a + 3 * m + channel];
+    }
+    for (int a = 0; a < num_cameras; ++a) {
+      for (int channel = 0; channel < 3; ++channel) {
+        double& value = values[stride * a + 3 * m + channel];
+        value = weight[channel] * (value - mean[channel] / num_cameras);
+      }
+    }
+  };
   for (int m = 0; m < n; ++m) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero(), mean_derivative = Eigen::Vector3d::Zero();
-    for (int a = 0; a < num_cameras; ++a) {
-      mean += z[a][m] / num_cameras;
-      if (jacobian != nullptr) mean_derivative += dz[a][m] / num_cameras;
-    }
-    for (int a = 0; a < num_cameras; ++a) {
-      const Eigen::Vector3d r = weight.cwiseProduct(z[a][m] - mean);
-      std::copy_n(r.data(), 3, residuals + (a * n + m) * 3);
-      if (jacobian == nullptr) continue;
-      const Eigen::Vector3d d = weight.cwiseProduct(dz[a][m] - mean_derivative);
-      std::copy_n(d.data(), 3, jacobian + (a * n + m) * 3);
-    }
+    against_mean(residuals, m);
+    if (jacobian != nullptr) against_mean(jacobian, m);
   }
-  if (options_.robust_fraction > 0.0) {
-    // The level of disagreement of unrelated patches: each normalised channel has unit
-    // variance, so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
-    const double unrelated =
-        3.0 * n * (num_cameras - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
-    Robustify(options_.robust_fraction * unrelated, blocks_[b].num_residuals, residuals, jacobian);
+}
+
+double ConsensusSimilarity::LossScale(int b) const {
+  // The level of disagreement of unrelated patches: each normalised channel has unit variance,
+  // so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
+  const double unrelated =
+      3.0 * PatchSize(b) * (NumCameras(b) - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
+  return options_.robust_fraction * unrelated;
+}
+
+void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
+  PlainResiduals(b, k, residuals, jacobian);
+  Robustify(LossScale(b), blocks_[b].num_residuals, residuals, jacobian);
+}
+
+SimilarityTerm::BlockSummary ConsensusSimilarity::SummaryAt(
+    int b, double k, bool with_derivatives, const Eigen::Vector3d* row_colors) const {
+  thread_local std::vector<double> residuals, jacobian;
+  const int num_residuals = blocks_[b].num_residuals;
+  residuals.resize(num_residuals);
+  jacobian.resize(with_derivatives ? num_residuals : 0);
+  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr, row_colors);
+  BlockSummary plain;
+  if (with_derivatives) {
+    plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
+  } else {
+    for (int r = 0; r < num_residuals; ++r) plain.squared_norm += residuals[r] * residuals[r];
   }
+  return Robustify(LossScale(b), plain, with_derivatives);
 }
 
 double ConsensusSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {
   if (gradient != nullptr) *gradient = Eigen::VectorXd::Zero(k.size());
   const int num_blocks = static_cast<int>(blocks_.size());
   double sum_of_squares = 0.0;
-#pragma omp parallel reduction(+ : sum_of_squares)
-  {
-    std::vector<double> residuals, jacobian;
-#pragma omp for schedule(dynamic, 64)
-    for (int b = 0; b < num_blocks; ++b) {
-      const int s = blocks_[b].parameters[0];
-      residuals.resize(blocks_[b].num_residuals);
-      jacobian.resize(residuals.size());
-      BlockAt(b, k[s], residuals.data(), gradient != nullptr ? jacobian.data() : nullptr);
-      double dcost = 0.0;
-      for (size_t r = 0; r < residuals.size(); ++r) {
-        sum_of_squares += residuals[r] * residuals[r];
-        if (gradient != nullptr) dcost += residuals[r] * jacobian[r];
-      }
-      // Each block owns one parameter: no two threads write the same entry.
-      if (gradient != nullptr) (*gradient)[s] = -dcost;
-    }
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : sum_of_squares)
+  for (int b = 0; b < num_blocks; ++b) {
+    const int s = blocks_[b].parameters[0];
+    const BlockSummary summary = SummaryAt(b, k[s], gradient != nullptr);
+    sum_of_squares += summary.squared_norm;
+    // Each block owns one parameter: no two threads write the same entry.
+    if (gradient != nullptr) (*gradient)[s] = -summary.gradient;
   }
   return -0.5 * sum_of_squares;
 }
@@ -415,52 +495,38 @@ void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_j
 void ConsensusSimilarity::PrepareBlockSummaries(const Eigen::VectorXd& k) {
   const int num_blocks = static_cast<int>(blocks_.size());
   summaries_.resize(num_blocks);
-#pragma omp parallel
-  {
-    std::vector<double> residuals, jacobian;
-#pragma omp for schedule(dynamic, 64)
-    for (int b = 0; b < num_blocks; ++b) {
-      residuals.resize(blocks_[b].num_residuals);
-      jacobian.resize(residuals.size());
-      BlockAt(b, k[blocks_[b].parameters[0]], residuals.data(), jacobian.data());
-      summaries_[b] = Summarise(residuals.data(), jacobian.data(), blocks_[b].num_residuals);
-    }
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    summaries_[b] = SummaryAt(b, k[blocks_[b].parameters[0]], true);
   }
 }
 
 void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
-  const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
-  if (!uniform) {
-    SimilarityTerm::BlockCosts(k, costs);
-    return;
-  }
-  RowColors row_colors(views_.size());
-  std::vector<std::pair<int, int>> rows;  // (camera, row) of every row of every camera.
-  for (size_t c = 0; c < views_.size(); ++c) {
-    const int num_rows = static_cast<int>(views_[c].pairs.surface_ids.size());
-    row_colors[c].resize(num_rows);
-    for (int row = 0; row < num_rows; ++row) rows.emplace_back(static_cast<int>(c), row);
-  }
-  const int num_rows = static_cast<int>(rows.size());
   const int num_blocks = static_cast<int>(blocks_.size());
   costs->resize(num_blocks);
+  const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
+  if (!uniform) {
+#pragma omp parallel for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
+    }
+    return;
+  }
+  // Every row at the same k: one set of Hermite weights for all.
+  const HermiteWeights weights = HermiteAt(k[0]);
+  const int num_rows = first_row_.back();
+  row_colors_.resize(num_rows);
   // One parallel region for both loops: on a busy machine each region's start and barrier can
   // wait a time slice for a thread, and the sweep calls this for every sample.
 #pragma omp parallel
   {
 #pragma omp for schedule(static)
-    for (int i = 0; i < num_rows; ++i) {
-      const auto [c, row] = rows[i];
-      row_colors[c][row] = Interpolate(c, row, k[0], nullptr);
+    for (int row = 0; row < num_rows; ++row) {
+      Blend(weights.value, &table_[long(row) * num_nodes_ + weights.node], row_colors_[row].data());
     }
-    std::vector<double> residuals;
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
-      residuals.resize(blocks_[b].num_residuals);
-      BlockAt(b, k[0], residuals.data(), nullptr, &row_colors);
-      double cost = 0.0;
-      for (double r : residuals) cost += r * r;
-      (*costs)[b] = cost;
+      (*costs)[b] = SummaryAt(b, k[0], false, row_colors_.data()).squared_norm;
     }
   }
 }

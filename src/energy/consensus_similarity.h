@@ -32,9 +32,13 @@
 // p_jc(k) is tabulated once per frame, with its derivative, at displacements sigma_hat / 2 apart
 // over [-k_max, k_max], and read between them by cubic Hermite interpolation (exact at the nodes,
 // C1 between them). The energy the solvers see is the interpolated one, and its Jacobians are
-// those of the interpolant, exactly. At a node, only the image Gaussians within `reach_sigmas`
-// combined standard deviations of the projected Gaussian there count (as ImageColorAround counts
-// them): the row's pair list covers its whole path over [-k_max, k_max].
+// those of the interpolant, exactly. A member's k, and so its node interval and Hermite weights,
+// is the same in every camera of the patch: they are computed once per member, and each camera
+// only reads its two nodes. What the solvers and the sweep need of a block is its sum of squares,
+// gradient and curvature: the robust loss is applied to those sums, and the robust residuals
+// themselves are written only for PrepareResiduals. At a node, only the image Gaussians within
+// `reach_sigmas` combined standard deviations of the projected Gaussian there count (as
+// ImageColorAround counts them): the row's pair list covers its whole path over [-k_max, k_max].
 //
 // Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
 // patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
@@ -66,14 +70,16 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
   void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
   void BlockResiduals(int block, double* residuals, double* jacobian) const override;
-  // Each block's summary straight from its residuals, without storing them (a frame's ~0.8 M
-  // residuals and as many derivatives, written and read back at every evaluation otherwise).
+  // Each block's summary straight from its residuals before the robust loss, without storing
+  // them (a frame's ~0.8 M residuals and as many derivatives, written and read back at every
+  // evaluation otherwise), the loss applied to the sums.
   void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
   bool IsLeastSquares() const override { return true; }
   // The tables hold all it reads of the pairs.
   bool ReadsPairLists() const override { return false; }
-  // Where every k_s is the same and the patches are flat (the plane sweep's samples), each
-  // pair-list row's colour is interpolated once instead of once for every patch it belongs to.
+  // Each block's sum of squares without storing its residuals. Where every k_s is the same and
+  // the patches are flat (the plane sweep's samples), each pair-list row's colour is interpolated
+  // once instead of once for every patch it belongs to.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
 
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
@@ -109,6 +115,24 @@ class ConsensusSimilarity : public SimilarityTerm {
     Eigen::Vector3f color;
     Eigen::Vector3f slope;
   };
+  // The cubic Hermite interpolation at one k, apart from the table it reads: the first node of
+  // the interval holding k, and the weights of that node's colour and slope and of the next
+  // node's in the colour (`value`) and in dcolour/dk (`derivative`, zero beyond the table, where
+  // the colour stays at its end value). Every row of every camera at the same k shares them.
+  struct HermiteWeights {
+    int node = 0;
+    double value[4];
+    double derivative[4];
+  };
+  HermiteWeights HermiteAt(double k) const;
+  // weights[0] p0 + weights[1] m0 + weights[2] p1 + weights[3] m1, per channel, of the colours p
+  // and slopes m of `nodes[0]` and `nodes[1]`.
+  static void Blend(const double weights[4], const TableNode* nodes, double* color) {
+    for (int channel = 0; channel < 3; ++channel) {
+      color[channel] = weights[0] * nodes[0].color[channel] + weights[1] * nodes[0].slope[channel] +
+                       weights[2] * nodes[1].color[channel] + weights[3] * nodes[1].slope[channel];
+    }
+  }
   // p_jc and dp_jc/dk at the table's nodes, for every row of every camera's pair list.
   void BuildTables(double k_max);
   // The nodes of one row of `view`'s pair list: ImageColorOfPairs over the image Gaussians in
@@ -116,20 +140,30 @@ class ConsensusSimilarity : public SimilarityTerm {
   // once per node.
   void TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
                    TableNode* nodes) const;
-  // Colours of every row of every camera's pair list at one k, [c][row].
-  using RowColors = std::vector<std::vector<Eigen::Vector3d>>;
-  // The colours (and, if asked, their k-derivatives) of block camera `a`'s patch with every
-  // member displaced by k along its own normal, interpolated in the tables; or, given
-  // `row_colors` (taken at this k, flat patches), read from them.
-  void PatchColors(int a, double k, std::vector<Eigen::Vector3d>* colors,
-                   std::vector<Eigen::Vector3d>* derivatives,
-                   const RowColors* row_colors = nullptr) const;
+  // Number of members of block b's patch (centre first).
+  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
+  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
+  // The colours of block b's patch in each of its cameras with every member displaced by k along
+  // its own normal (and the patch's shape), interpolated in the tables, and, when `derivatives`
+  // is not null, their k-derivatives; or, given `row_colors` (every table row's colour at this
+  // k, flat patches), read from them. Written camera after camera, member after member, channel
+  // after channel: the order of the block's residuals.
+  void PatchColors(int b, double k, double* colors, double* derivatives,
+                   const Eigen::Vector3d* row_colors = nullptr) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
-  // The residuals of block b at displacement k of its patch, and, when `jacobian` is not null,
-  // their derivatives.
-  void BlockAt(int b, double k, double* residuals, double* jacobian,
-               const RowColors* row_colors = nullptr) const;
+  // The residuals of block b at displacement k of its patch before the robust loss, and, when
+  // `jacobian` is not null, their derivatives; `row_colors` as for PatchColors.
+  void PlainResiduals(int b, double k, double* residuals, double* jacobian,
+                      const Eigen::Vector3d* row_colors = nullptr) const;
+  // The scale c2 of block b's robust loss (none when not positive).
+  double LossScale(int b) const;
+  // Block b's residuals, and their derivatives when `jacobian` is not null.
+  void BlockAt(int b, double k, double* residuals, double* jacobian) const;
+  // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
+  // applied to the sums instead of to every residual: what the solvers and the sweep need.
+  BlockSummary SummaryAt(int b, double k, bool with_derivatives,
+                         const Eigen::Vector3d* row_colors = nullptr) const;
 
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
@@ -139,18 +173,25 @@ class ConsensusSimilarity : public SimilarityTerm {
   double scale_;  // 1 / sqrt(n_c).
 
   std::vector<ResidualBlock> blocks_;  // One per patch; its parameter: the centre's k.
-  // Block b's cameras are cameras_[camera_begin_[b] ..); rows_[a] (same index a) holds, for each
-  // patch member (centre first), its row in that camera's pair list.
-  std::vector<int> camera_begin_;
-  std::vector<int> cameras_;
-  std::vector<std::vector<int>> rows_;
+  // Block b's patch members (surface Gaussians, centre first) are
+  // members_[patch_begin_[b] ..), and its cameras cameras_[camera_begin_[b] ..). For each of
+  // those cameras in turn, rows_ (from row_begin_[b]) holds every member's table row: its row in
+  // that camera's pair list plus the camera's first_row_.
+  std::vector<int> patch_begin_, members_;
+  std::vector<int> camera_begin_, cameras_;
+  std::vector<long> row_begin_;
+  std::vector<int> rows_;
   std::vector<Eigen::Vector3d> weights_;
 
-  // Node g of the tables is at k = node_k0_ + g * node_step_; table_[c][row * num_nodes_ + g].
+  // Node g of the tables is at k = node_k0_ + g * node_step_. All cameras' rows in one table:
+  // camera c's pair-list row `row` is table row first_row_[c] + row, its node g at
+  // table_[(first_row_[c] + row) * num_nodes_ + g].
   double node_k0_ = 0.0, node_step_ = 1.0;
   int num_nodes_ = 0;
-  std::vector<std::vector<TableNode>> table_;
+  std::vector<int> first_row_;
+  std::vector<TableNode> table_;
   Eigen::VectorXd shape_;
+  std::vector<Eigen::Vector3d> row_colors_;  // BlockCosts' colour of every table row.
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_;
