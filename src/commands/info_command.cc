@@ -1,5 +1,6 @@
 // finecap info: the capture as finecap reads it and the problem a refinement would solve, without
 // refining or writing anything. Every figure comes from the library functions a run uses.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -72,7 +73,8 @@ int RunInfo(const Config& configured) {
   const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
   FrameInput input = ReadFrameInput(&capture, first);
   const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config.validation.cameras, &input);
-  const ProblemSize size = EstimateProblemSize(model, colors, input, config.refine);
+  const ProblemSize size =
+      EstimateProblemSize(model, colors, input, config.refine, std::max(frames.size(), 1));
 
   std::cout << "capture: " << capture.directory() << "\n";
   PrintCameras(capture, input.cameras, held_out, size);

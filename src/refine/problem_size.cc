@@ -20,12 +20,15 @@ constexpr int kSampledSurfaceGaussians = 3000;
 constexpr double kBaseMegabytes = 88.0;  // The process: code, libraries, thread stacks, allocator.
 // The 8-bit images and the buffers of one at a time.
 constexpr double kBytesPerPixel = 5.5;
-// The next frame's 8-bit images, read while this one is solved.
+// The next frame's 8-bit images, read while this one is solved (runs of more than one frame).
 constexpr double kBytesPerPixelReadAhead = 3.0;
 // The consensus similarity's patch residuals, Jacobians and member rows, per surface Gaussian and
 // camera that sees it.
 constexpr double kConsensusBytesPerObservation = 400.0;
-constexpr double kBytesPerPair = 8.0;  // The image Gaussian's id and the pair's colour weight.
+// The image Gaussian's id and the pair's colour weight; the consensus similarity's pairs carry no
+// weight (every one is 1).
+constexpr double kBytesPerPair = 8.0;
+constexpr double kBytesPerConsensusPair = 4.0;
 // Residual blocks, neighbourhoods, the regulariser and the solver's sparse matrices, which grow
 // with the surface Gaussians (not with the cameras that see them): with conjugate gradients
 // (Ceres' CGNR, the default), and with the sparse Cholesky factorisation, whose normal equations
@@ -43,7 +46,8 @@ constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 }  // namespace
 
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
-                                const FrameInput& frame, const RefineOptions& options) {
+                                const FrameInput& frame, const RefineOptions& options,
+                                int num_frames) {
   ProblemSize size;
   const Mesh fine = model.Subdivide(frame.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
@@ -78,18 +82,22 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   }
 
   double bytes =
-      size.num_pixels * (kBytesPerPixel + kBytesPerPixelReadAhead) +
-      size.num_pairs * kBytesPerPair +
+      size.num_pixels * (kBytesPerPixel + (num_frames > 1 ? kBytesPerPixelReadAhead : 0.0)) +
+      size.num_pairs * (options.energy.similarity == SimilarityType::kConsensus
+                            ? kBytesPerConsensusPair
+                            : kBytesPerPair) +
       size.num_surface_gaussians * (options.solver.type == SolverType::kCeres &&
                                             options.solver.linear_solver != LinearSolverType::kCgnr
                                         ? kBytesPerSurfaceGaussianCholesky
                                         : kBytesPerSurfaceGaussian);
   if (options.energy.similarity == SimilarityType::kConsensus) {
-    // Its colour tables (value and derivative, 3 floats each, per node) and the residuals and
-    // Jacobians of the patches (3 channels of about 7 members, two doubles each) per
-    // observation, and the sweep's cost matrix and its smoothing copy.
+    // Its colour tables (value and derivative, 3 floats each, per node), the residuals and
+    // Jacobians of the patches (3 channels of about 7 members, two doubles each) per observation,
+    // and the sweep's cost matrix and its smoothing copy; with more frames to come, the tables of
+    // the next, which the sequence prepares while this one is solved (PrepareFrameAhead).
     const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
-    bytes += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation) +
+    const int tables = num_frames > 1 ? 2 : 1;
+    bytes += size.num_observations * (tables * nodes * 24.0 + kConsensusBytesPerObservation) +
              size.num_surface_gaussians * options.sweep.samples * 16.0;
   }
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;

@@ -241,9 +241,9 @@ class SequenceRun {
   // The size of the first frame's problem and what it forecasts, before the long part of the run.
   void ReportProblemSize(const FrameRange& frames) {
     FrameReadAhead::Frame first = reader_.Take(frames.begin);
-    observer_->Starting(
-        frames.size(), first.input,
-        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine));
+    observer_->Starting(frames.size(), first.input,
+                        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine,
+                                            frames.size()));
     reader_.Keep(frames.begin, std::move(first));
   }
 

@@ -47,10 +47,13 @@ struct ProblemSize {
 };
 
 // The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
-// `options` (whose lengths should be resolved: scene_scale.h). Builds the frame's image Gaussians
-// and visibility, so it costs a few seconds on a large rig, and keeps none of it.
+// `options` (whose lengths should be resolved: scene_scale.h), in a run of `num_frames` frames
+// like it: with more than one, the next frame is read and prepared while one is solved, and the
+// memory forecast holds both. Builds the frame's image Gaussians and visibility, so it costs a
+// few seconds on a large rig, and keeps none of it.
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
-                                const FrameInput& frame, const RefineOptions& options);
+                                const FrameInput& frame, const RefineOptions& options,
+                                int num_frames = 1);
 
 }  // namespace finecap
 
