@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Ceres against the paper's gradient ascent to the same accuracy on synth_skirt (8 cameras of
-# 1004 x 1004, ~10k surface Gaussians, the default energy), by the whole time of a frame (its
-# preparation, the sweep and both passes of the solve: stats.jsonl "seconds", so that a run's
-# one-off start does not dilute the ratio). Ceres with its defaults; the ascent with no function
+# 1004 x 1004, ~10k surface Gaussians, the default energy), by the time of a frame on the run's
+# thread (stats.jsonl "seconds", so that a run's one-off start does not dilute the ratio: both
+# passes of the solve, writing, and waiting for the frame's preparation and sweep, which run
+# beside the solve of the frame before), and by the solve alone ("seconds_solve"). Ceres with
+# its defaults; the ascent with no function
 # tolerance and a ladder of iteration budgets; run after run in turn, so that a load from
 # elsewhere falls on all alike. The ascent's speed at Ceres' accuracy is read off the ladder:
 # the time per frame interpolated between the last budget that ends above Ceres' RMS error and
@@ -13,7 +15,8 @@
 #
 # Prints one "name: value" a line: ceres_frames_per_minute and ceres_rms_mm; per budget N
 # ascent_N_frames_per_minute and ascent_N_rms_mm; ascent_frames_per_minute_at_ceres_rms ("not
-# reached" when no budget gets there) and ceres_to_ascent_speed_ratio. Frames per minute are 60
+# reached" when no budget gets there) and ceres_to_ascent_speed_ratio; ceres_solve_seconds,
+# ascent_solve_seconds_at_ceres_rms and ceres_to_ascent_solve_ratio. Frames per minute are 60
 # over the median over the runs of the mean seconds per frame; RMS is over frames of the
 # per-frame RMS error of k against the truth.
 set -euo pipefail
@@ -38,25 +41,32 @@ median() {
     awk '{ v[NR] = $1 } END { printf "%.3f", (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'
 }
 
-run() {  # output folder, refine arguments...; prints the mean of the frames' seconds
-  local dir=$1
-  shift
-  rm -rf "$dir"
-  build/finecap refine --capture "$work/capture" --out "$dir" "$@" >/dev/null 2>&1
-  grep -o '"seconds": [0-9.eE+-]*' "$dir/stats.jsonl" |
-    awk '{ s += $2; n += 1 } END { printf "%.4f", s / n }'
+mean_of() {  # stats.jsonl key, stats file; the mean over the frames
+  grep -o "\"$1\": [0-9.eE+-]*" "$2" | awk '{ s += $2; n += 1 } END { printf "%.4f", s / n }'
 }
 
-declare -A seconds
+# Output folder, then the refine arguments; appends the run's mean seconds per frame and mean
+# solve seconds per frame to seconds[$key] and solve[$key].
+run() {
+  local key=$1 dir=$2
+  shift 2
+  rm -rf "$dir"
+  build/finecap refine --capture "$work/capture" --out "$dir" "$@" >/dev/null 2>&1
+  seconds[$key]+=" $(mean_of seconds "$dir/stats.jsonl")"
+  solve[$key]+=" $(mean_of seconds_solve "$dir/stats.jsonl")"
+}
+
+declare -A seconds solve
 for ((i = 0; i < repeats; ++i)); do
-  seconds[ceres]+=" $(run "$work/ceres" --solver ceres)"
+  run ceres "$work/ceres" --solver ceres
   for n in $budgets; do
-    seconds[$n]+=" $(run "$work/ascent_$n" --solver gradient-ascent \
-      --set "solver.max_iterations=$n,solver.function_tolerance=0")"
+    run "$n" "$work/ascent_$n" --solver gradient-ascent \
+      --set "solver.max_iterations=$n,solver.function_tolerance=0"
   done
 done
 
 ceres_seconds=$(echo "${seconds[ceres]}" | median)
+ceres_solve=$(echo "${solve[ceres]}" | median)
 ceres_rms=$(rms_of "$work/ceres/stats.jsonl")
 echo "frames: $frames"
 echo "runs_each: $repeats"
@@ -68,20 +78,29 @@ for n in $budgets; do
   rms=$(rms_of "$work/ascent_$n/stats.jsonl")
   echo "ascent_${n}_frames_per_minute: $(echo "$s" | awk '{ printf "%.1f", 60 / $1 }')"
   echo "ascent_${n}_rms_mm: $rms"
-  ladder+="$s $rms"$'\n'
+  ladder+="$s $(echo "${solve[$n]}" | median) $rms"$'\n'
 done
-# Seconds per frame where the ladder first reaches Ceres' RMS, interpolated in RMS.
-at_target=$(printf '%s' "$ladder" | awk -v target="$ceres_rms" '
-  $2 <= target {
-    if (NR == 1 || previous_rms <= $2) { print $1; found = 1; exit }
-    print previous_s + ($1 - previous_s) * (previous_rms - target) / (previous_rms - $2)
-    found = 1; exit
-  }
-  { previous_s = $1; previous_rms = $2 }
-  END { if (!found) print "none" }')
-if [ "$at_target" = none ]; then
+# Column $1 of the ladder (seconds per frame, or solve seconds) where it first reaches Ceres' RMS,
+# interpolated in RMS.
+at_target() {
+  printf '%s' "$ladder" | awk -v target="$ceres_rms" -v c="$1" '
+    $3 <= target {
+      if (NR == 1 || previous_rms <= $3) { print $c; found = 1; exit }
+      print previous + ($c - previous) * (previous_rms - target) / (previous_rms - $3)
+      found = 1; exit
+    }
+    { previous = $c; previous_rms = $3 }
+    END { if (!found) print "none" }'
+}
+frame_at_target=$(at_target 1)
+solve_at_target=$(at_target 2)
+if [ "$frame_at_target" = none ]; then
   echo "ascent_frames_per_minute_at_ceres_rms: not reached"
 else
-  echo "ascent_frames_per_minute_at_ceres_rms: $(echo "$at_target" | awk '{ printf "%.1f", 60 / $1 }')"
-  echo "ceres_to_ascent_speed_ratio: $(echo "$at_target $ceres_seconds" | awk '{ printf "%.2f", $1 / $2 }')"
+  echo "ascent_frames_per_minute_at_ceres_rms: $(echo "$frame_at_target" | awk '{ printf "%.1f", 60 / $1 }')"
+  echo "ceres_to_ascent_speed_ratio: $(echo "$frame_at_target $ceres_seconds" | awk '{ printf "%.2f", $1 / $2 }')"
+  # The solves alone: the preparation both share runs beside the frame before's solve.
+  echo "ceres_solve_seconds: $ceres_solve"
+  echo "ascent_solve_seconds_at_ceres_rms: $(echo "$solve_at_target" | awk '{ printf "%.3f", $1 }')"
+  echo "ceres_to_ascent_solve_ratio: $(echo "$solve_at_target $ceres_solve" | awk '{ printf "%.2f", $1 / $2 }')"
 fi
