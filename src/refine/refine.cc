@@ -182,6 +182,10 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
   return frame;
 }
 
+bool ReadsImagesAfterPreparation(const RefineOptions& options) {
+  return options.coarse_to_fine.levels > 1;
+}
+
 namespace {
 
 // Solve, and for the consensus similarity the further passes with patches shaped like the surface

@@ -301,9 +301,9 @@ class SequenceRun {
   void WorkAhead(int frame, FrameReadAhead::Frame* read) const {
     if (prepare_ahead_) {
       read->prepared = PrepareFrameAhead(model_, reference_colors_, &read->input, options_.refine);
-      // Only the held-out score and the coarser levels of a schedule read the pixels after this:
-      // two frames' images are a run's largest buffers.
-      if (options_.held_out_cameras.empty() && options_.refine.coarse_to_fine.levels == 1) {
+      // Beside the refinement only the held-out score reads the pixels after this: two frames'
+      // images are a run's largest buffers.
+      if (options_.held_out_cameras.empty() && !ReadsImagesAfterPreparation(options_.refine)) {
         read->input.images.clear();
       }
     }

@@ -203,6 +203,11 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColors& colors,
                                 FrameInput* input, const RefineOptions& options);
 
+// Whether RefineFrame, handed PrepareFrameAhead's preparation of a frame, still reads the input's
+// images: only the coarser levels of a coarse-to-fine schedule model them afresh. When it does
+// not, a caller with no other use for them may release them once the frame is prepared.
+bool ReadsImagesAfterPreparation(const RefineOptions& options);
+
 struct FrameResult {
   Mesh refined;              // The fine mesh with the displacement applied.
   Eigen::Matrix3Xd normals;  // Unit normals of `refined`.
