@@ -116,6 +116,25 @@ void ExpectQueriesMatchBruteForce(const ImageGaussians& gaussians, unsigned seed
       return (Eigen::Vector2d(g.x, g.y) - p).squaredNorm() <= c * c * (s * s + sigma_i * sigma_i);
     };
     EXPECT_EQ(Sorted(found), BruteForce(gaussians, reaching)) << "sigma " << s << " at " << p;
+
+    // A segment in any direction, as the path of a surface Gaussian's projection: level and
+    // upright ones too, whose rows or columns the scan bounds exactly.
+    const double angle = q % 5 == 0 ? 0.0 : q % 5 == 1 ? M_PI / 2 : 0.02 * q;
+    const Eigen::Vector2d end =
+        p + radius(rng) * 1.5 * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    gaussians.FindReachingSegment(p, end, s, c, &found);
+    const auto reaching_segment = [&](const ImageGaussian& g) {
+      const Eigen::Vector2d direction = end - p;
+      const Eigen::Vector2d offset = Eigen::Vector2d(g.x, g.y) - p;
+      const double length_squared = direction.squaredNorm();
+      const double t =
+          length_squared > 0.0 ? std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) : 0.0;
+      const double sigma_i = g.sigma, cutoff_squared = c * c;
+      return (offset - t * direction).squaredNorm() <=
+             cutoff_squared * s * s + cutoff_squared * sigma_i * sigma_i;
+    };
+    EXPECT_EQ(Sorted(found), BruteForce(gaussians, reaching_segment))
+        << "sigma " << s << " from " << p.transpose() << " to " << end.transpose();
   }
 }
 

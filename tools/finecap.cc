@@ -16,6 +16,7 @@
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
 #include "finecap/util/error.h"
+#include "finecap/util/heap.h"
 #include "finecap/util/threads.h"
 
 DECLARE_bool(help);
@@ -237,6 +238,7 @@ __attribute__((section(".preinit_array"),
 
 int main(int argc, char** argv) {
   finecap::UseOneMallocArena();
+  finecap::BackHeapWithHugePages(1 << 30);
   try {
     return finecap::Main(argc, argv);
   } catch (const finecap::Error& error) {

@@ -120,7 +120,7 @@ void FrameReadAhead::DropPending() {
 void FrameReadAhead::ReadAhead(int frame) {
   if (pending_.valid() || kept_frame_ == frame) return;
   pending_frame_ = frame;
-  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame); });
+  pending_ = std::async(std::launch::async, [this, frame] { return Read(frame, true); });
 }
 
 void FrameReadAhead::Keep(int frame, Frame read) {
@@ -135,19 +135,21 @@ FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
   if (kept_frame == frame) return kept;
   if (pending_.valid() && pending_frame_ == frame) return pending_.get();
   DropPending();  // A read of another frame.
-  return Read(frame);
+  return Read(frame, false);
 }
 
-FrameReadAhead::Frame FrameReadAhead::Read(int frame) {
+FrameReadAhead::Frame FrameReadAhead::Read(int frame, bool ahead) {
   Frame read;
   // In parallel, as the solve it overlaps: on two cores, whichever of the two ends first leaves
-  // the other both; but the images modelled one at a time, which holds one image's buffers instead
-  // of one per thread (a run's peak memory is higher by ~5 MB otherwise, for no speed measured).
+  // the other both; but ahead of a solve the images are modelled one at a time, which holds one
+  // image's buffers instead of one per thread (a run's peak memory is higher by ~5 MB otherwise,
+  // for no speed measured). A frame read while the run waits for it (the reference frame, before
+  // the colours) has the cores to itself, and its images are modelled side by side.
   const ScopedOpenMpThreads parallel(threads_);
   read.input = ReadFrameInput(capture_, frame, skip_unreadable_, &read.skipped);
   read.held_out = TakeHeldOutViews(held_out_, &read.input);
   if (image_options_) {
-    const ScopedOpenMpThreads one(1);
+    const ScopedOpenMpThreads modelling(ahead ? 1 : threads_);
     ModelFrameImages(*image_options_, &read.input);
   }
   if (work_ahead_) work_ahead_(frame, &read);

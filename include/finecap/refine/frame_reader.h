@@ -83,7 +83,9 @@ class FrameReadAhead {
   void DropPending();
 
  private:
-  Frame Read(int frame);
+  // `ahead`: read on the reader's thread, beside the work on the caller's; else on the caller's,
+  // which waits for it.
+  Frame Read(int frame, bool ahead);
 
   Capture* capture_;
   bool skip_unreadable_;
