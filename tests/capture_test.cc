@@ -121,6 +121,23 @@ TEST(CaptureTest, GoodCaptureOpensAndReads) {
   ExpectErrorMentions([&] { capture.ReadImage(2, 0); }, {dir, "camera index 2"});
 }
 
+// Frame 0's images, decoded as the capture opens, serve the first read of that frame: a read
+// after it, or after another frame's, decodes the same image again, whatever the caller did to
+// the one it was given.
+TEST(CaptureTest, FirstFrameReadAgainIsTheSame) {
+  const std::string dir = MakeCapture();
+  Capture capture = Capture::Open(dir);
+  for (int camera = 0; camera < 2; ++camera) {
+    cv::Mat first = capture.ReadImage(camera, 0);
+    const cv::Mat kept = first.clone();
+    first.setTo(cv::Scalar::all(255));
+    EXPECT_EQ(cv::norm(capture.ReadImage(camera, 0), kept, cv::NORM_INF), 0.0) << camera;
+  }
+  Capture other = Capture::Open(dir);
+  EXPECT_NEAR(other.ReadImage(1, 2).at<cv::Vec3b>(15, 20)[0], Level(1, 2), 3);
+  EXPECT_NEAR(other.ReadImage(1, 0).at<cv::Vec3b>(15, 20)[0], Level(1, 0), 3);
+}
+
 TEST(CaptureTest, IntriExtriRigTakesItsSizeFromTheFirstImage) {
   const std::string dir = MakeCapture();
   fs::remove(dir + "/cameras.yaml");

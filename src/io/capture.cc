@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <exception>
 #include <filesystem>
 #include <map>
 #include <sstream>
+#include <utility>
 
 #include "finecap/io/camera_io.h"
 #include "finecap/io/mesh_io.h"
@@ -129,7 +131,22 @@ void Capture::OpenFrameSources() {
   for (const Camera& camera : rig_) {
     sources_.push_back(
         OpenFrameSource(FindCameraStream(directory_, camera.name), frame_names_, camera));
-    sources_.back()->Read(0);  // Decodes and checks the size of the first image.
+  }
+  // Decodes and checks the first image of each camera, the cameras side by side; a failure is
+  // reported as the cameras taken in the rig's order would meet it.
+  const int num_sources = static_cast<int>(sources_.size());
+  first_images_.resize(num_sources);
+  std::vector<std::exception_ptr> failures(num_sources);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int c = 0; c < num_sources; ++c) {
+    try {
+      first_images_[c] = sources_[c]->Read(0);
+    } catch (...) {
+      failures[c] = std::current_exception();
+    }
+  }
+  for (const std::exception_ptr& failure : failures) {
+    if (failure) std::rethrow_exception(failure);
   }
 }
 
@@ -176,6 +193,11 @@ cv::Mat Capture::ReadImage(int camera_index, int frame) {
           "camera index " + std::to_string(camera_index) + " is outside [0, " +
               std::to_string(num_cameras()) + ")");
   RequireFrame(frame);
+  cv::Mat& first = first_images_[camera_index];
+  if (!first.empty()) {
+    if (frame == 0) return std::exchange(first, cv::Mat());
+    first.release();
+  }
   return sources_[camera_index]->Read(frame);
 }
 

@@ -106,6 +106,10 @@ class Capture {
   std::vector<std::string> mesh_paths_;
   Mesh first_mesh_;
   std::vector<std::unique_ptr<FrameSource>> sources_;
+  // Per camera, its image of frame 0, decoded as the capture opened to check it: the first
+  // ReadImage of that frame takes it instead of decoding it again, and a read of any other frame
+  // drops it.
+  std::vector<cv::Mat> first_images_;
   std::vector<int> vertex_mask_;
   bool has_vertex_mask_ = false;
   bool has_ground_truth_ = false;
