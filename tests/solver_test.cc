@@ -1,16 +1,19 @@
 #include "finecap/solvers/solver.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <utility>
 
 #include <ceres/gradient_checker.h>
+#include <ceres/problem.h>
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
 #include "finecap/util/error.h"
 #include "solvers/ceres_cost_functions.h"
+#include "solvers/solvers_internal.h"
 
 namespace finecap {
 namespace {
@@ -96,6 +99,135 @@ TEST(CeresCostTest, SmoothnessBlocksPassTheGradientChecker) {
   const SmoothnessBlockCost prior_only(0.7, {}, 0);
   EXPECT_EQ(prior_only.num_residuals(), 1);
   EXPECT_TRUE(CheckGradient(prior_only, {0.004}, &error)) << error;
+}
+
+// A surface Gaussian's merged block (its similarity block of one parameter, a prior and three
+// neighbours, one fixed at 0): its gradient J^T r, with the secant's model, against central
+// differences of its cost 1/2 |r|^2, the similarity prepared at each point. The similarity rows
+// are the reduced ones, whose Jacobian is not their derivative (ReducedSimilarityBlockCost), so
+// the gradient is what is checked; the smoothness rows match SmoothnessBlockCost's, and the
+// similarity rows are zero in the neighbours' columns.
+TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
+  const auto [similarity, overlap] = GetParam();
+  CostScene scene(similarity, overlap);
+  SimilarityTerm& term = scene.energy.similarity();
+  Eigen::VectorXd point = scene.k;
+  double seconds = 0.0;
+  SharedEvaluationCallback callback(&term, &point, &seconds);
+  const std::vector<SmoothnessBlockCost::Neighbour> neighbours = {{1, 3.5}, {-1, 1.5}, {2, 2.0}};
+  const SmoothnessBlockCost smoothness(0.7, neighbours, 2);
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  int checked = 0;
+  for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 20)) {
+    if (term.residual_blocks()[b].parameters.size() != 1) continue;
+    const int s = term.residual_blocks()[b].parameters[0];
+    const SurfaceGaussianCost cost(term, b, true, 0.7, neighbours, 2);
+    ASSERT_EQ(cost.num_residuals(), 2 + smoothness.num_residuals());
+    ASSERT_EQ(cost.parameter_block_sizes().size(), 3u);
+    const int m = cost.num_residuals();
+    std::vector<double> values = {scene.k[s], 0.0011, -0.0023};
+    std::vector<const double*> parameters;
+    for (const double& value : values) parameters.push_back(&value);
+    // 1/2 |r|^2 at `values`, the similarity prepared at k with k_s = values[0].
+    auto half_squared_norm = [&]() {
+      point = scene.k;
+      point[s] = values[0];
+      callback.PrepareForEvaluation(false, true);
+      Eigen::VectorXd r(m);
+      EXPECT_TRUE(cost.Evaluate(parameters.data(), r.data(), nullptr));
+      return 0.5 * r.squaredNorm();
+    };
+    half_squared_norm();
+    Eigen::VectorXd r(m);
+    std::vector<Eigen::VectorXd> columns(3, Eigen::VectorXd::Constant(m, std::nan("")));
+    std::vector<double*> jacobians = {columns[0].data(), columns[1].data(), columns[2].data()};
+    ASSERT_TRUE(cost.Evaluate(parameters.data(), r.data(), jacobians.data()));
+
+    Eigen::VectorXd smoothness_r(smoothness.num_residuals());
+    std::vector<Eigen::VectorXd> smoothness_columns(3, Eigen::VectorXd(smoothness_r.size()));
+    std::vector<double*> smoothness_jacobians = {
+        smoothness_columns[0].data(), smoothness_columns[1].data(), smoothness_columns[2].data()};
+    ASSERT_TRUE(
+        smoothness.Evaluate(parameters.data(), smoothness_r.data(), smoothness_jacobians.data()));
+    EXPECT_EQ(r.tail(smoothness_r.size()), smoothness_r) << "block " << b;
+    for (int p = 0; p < 3; ++p) {
+      EXPECT_EQ(columns[p].tail(smoothness_r.size()), smoothness_columns[p]) << "block " << b;
+      if (p > 0) {
+        EXPECT_EQ(columns[p].head(2), Eigen::Vector2d::Zero()) << "block " << b;
+      }
+    }
+
+    constexpr double kStep = 1e-7;  // Metres; k is a few millimetres.
+    for (int p = 0; p < 3; ++p) {
+      const double analytic = columns[p].dot(r);
+      const double value = values[p];
+      values[p] = value + kStep;
+      const double above = half_squared_norm();
+      values[p] = value - kStep;
+      const double below = half_squared_norm();
+      values[p] = value;
+      const double numeric = (above - below) / (2.0 * kStep);
+      EXPECT_NEAR(analytic, numeric, 1e-5 * (std::abs(numeric) + columns[p].norm() * r.norm()))
+          << "block " << b << ", parameter " << p;
+    }
+    ++checked;
+  }
+  if (similarity != "paper") {
+    EXPECT_GE(checked, 10);
+  }
+}
+
+// One residual block per surface Gaussian (its similarity block of one parameter and its
+// smoothness residuals together) is the same least-squares problem as the blocks apart: the same
+// residuals in fewer blocks, and a few Levenberg-Marquardt iterations end at the same k and cost,
+// to rounding.
+TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
+  const auto [similarity, overlap] = GetParam();
+  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
+  EnergyOptions energy_options = Options(similarity, overlap);
+  energy_options.w_prior = 1e-4;
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, energy_options);
+  Eigen::VectorXd start(energy.num_parameters());
+  for (int s = 0; s < start.size(); ++s) start[s] = 0.002 * std::sin(1.7 * s);
+
+  using Layout = FrameCostFunctions::Layout;
+  auto count_blocks = [&](Layout layout, int* num_residuals) {
+    Eigen::VectorXd k = start;
+    FrameCostFunctions cost_functions;
+    ceres::Problem::Options problem_options;
+    problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    cost_functions.AddResidualBlocks(energy, true, layout, &k, &problem);
+    *num_residuals = problem.NumResiduals();
+    return problem.NumResidualBlocks();
+  };
+  int separate_residuals = 0, merged_residuals = 0;
+  const int separate_blocks = count_blocks(Layout::kSeparate, &separate_residuals);
+  const int merged_blocks = count_blocks(Layout::kPerGaussian, &merged_residuals);
+  EXPECT_EQ(merged_residuals, separate_residuals);
+  EXPECT_LT(merged_blocks, separate_blocks);
+  if (similarity != "paper") {
+    EXPECT_EQ(merged_blocks, energy.num_parameters());
+  }
+
+  SolverOptions options;
+  options.max_iterations = 5;
+  options.function_tolerance = 1e-12;
+  options.num_threads = 2;
+  auto solve = [&](Layout layout, Eigen::VectorXd* k) {
+    *k = start;
+    SolverSummary summary;
+    internal::SolveWithCeres(&energy, options, k, &summary, layout);
+    return summary;
+  };
+  Eigen::VectorXd k_separate, k_merged;
+  const SolverSummary separate = solve(Layout::kSeparate, &k_separate);
+  const SolverSummary merged = solve(Layout::kPerGaussian, &k_merged);
+  ASSERT_GT(separate.iterations, 1);
+  EXPECT_EQ(merged.iterations, separate.iterations);
+  ASSERT_GT((k_separate - start).norm(), 1e-3 * start.norm()) << "the solve did not move";
+  EXPECT_LE((k_merged - k_separate).norm(), 1e-9 * k_separate.norm());
+  EXPECT_NEAR(merged.ls_cost_end, separate.ls_cost_end, 1e-9 * separate.ls_cost_end);
 }
 
 // The problem Ceres is given (similarity blocks, one smoothness block per Gaussian) has the cost

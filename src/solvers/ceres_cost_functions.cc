@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include <Eigen/QR>
 
@@ -196,6 +197,119 @@ bool SmoothnessBlockCost::Evaluate(double const* const* parameters, double* resi
     ++r;
   }
   return true;
+}
+
+SurfaceGaussianCost::SurfaceGaussianCost(const SimilarityTerm& term, int similarity_block,
+                                         bool secant, double prior_root,
+                                         std::vector<SmoothnessBlockCost::Neighbour> neighbours,
+                                         int num_free)
+    : similarity_(term, similarity_block, secant),
+      smoothness_(prior_root, std::move(neighbours), num_free) {
+  set_num_residuals(similarity_.num_residuals() + smoothness_.num_residuals());
+  *mutable_parameter_block_sizes() = smoothness_.parameter_block_sizes();
+}
+
+bool SurfaceGaussianCost::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const int num_similarity = similarity_.num_residuals();
+  if (jacobians == nullptr) {
+    return similarity_.Evaluate(parameters, residuals, nullptr) &&
+           smoothness_.Evaluate(parameters, residuals + num_similarity, nullptr);
+  }
+  // Each parameter block's Jacobian is one column (all blocks are 1-D): the similarity's rows
+  // first, zero but in k_s's column, then the smoothness rows.
+  const int num_parameters = static_cast<int>(parameter_block_sizes().size());
+  thread_local std::vector<double*> smoothness_jacobians;
+  smoothness_jacobians.assign(num_parameters, nullptr);
+  for (int p = 0; p < num_parameters; ++p) {
+    if (jacobians[p] == nullptr) continue;
+    if (p > 0) std::fill_n(jacobians[p], num_similarity, 0.0);
+    smoothness_jacobians[p] = jacobians[p] + num_similarity;
+  }
+  return similarity_.Evaluate(parameters, residuals, jacobians) &&
+         smoothness_.Evaluate(parameters, residuals + num_similarity, smoothness_jacobians.data());
+}
+
+namespace {
+
+// The smoothness residuals of one surface Gaussian s, and the parameter blocks they read: k_s,
+// then each free neighbour in the order of `neighbours`.
+struct SmoothnessRows {
+  double prior_root = 0.0;  // sqrt(h_s), or 0 for no prior residual.
+  std::vector<SmoothnessBlockCost::Neighbour> neighbours;
+  std::vector<double*> parameter_blocks;
+  int num_free() const { return static_cast<int>(parameter_blocks.size()) - 1; }
+  bool empty() const { return prior_root == 0.0 && neighbours.empty(); }
+};
+
+// Each pair of neighbours goes to its first Gaussian, `pair.a`.
+std::vector<SmoothnessRows> SmoothnessRowsOfEachGaussian(const FrameEnergy& energy,
+                                                         Eigen::VectorXd* k) {
+  const Regularizer& regularizer = energy.regularizer();
+  const Eigen::VectorXd& prior = energy.prior_curvature();
+  const double w_reg = energy.options().w_reg;
+  std::vector<SmoothnessRows> rows(k->size());
+  for (int s = 0; s < k->size(); ++s) {
+    rows[s].prior_root = prior[s] > 0.0 ? std::sqrt(prior[s]) : 0.0;
+    rows[s].parameter_blocks.push_back(&(*k)[s]);
+  }
+  if (w_reg == 0.0) return rows;
+  for (const Regularizer::Pair& pair : regularizer.pairs()) {
+    SmoothnessRows& owner = rows[pair.a];
+    SmoothnessBlockCost::Neighbour neighbour;
+    neighbour.coefficient = 2.0 * std::sqrt(w_reg * pair.weight) * regularizer.unit_scale();
+    if (pair.b >= 0) {
+      neighbour.parameter = static_cast<int>(owner.parameter_blocks.size());
+      owner.parameter_blocks.push_back(&(*k)[pair.b]);
+    }
+    owner.neighbours.push_back(neighbour);
+  }
+  return rows;
+}
+
+}  // namespace
+
+void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout,
+                                           Eigen::VectorXd* k, ceres::Problem* problem) {
+  const double k_max = energy.options().k_max;
+  for (int s = 0; s < k->size(); ++s) {
+    problem->AddParameterBlock(&(*k)[s], 1);
+    problem->SetParameterLowerBound(&(*k)[s], 0, -k_max);
+    problem->SetParameterUpperBound(&(*k)[s], 0, k_max);
+  }
+  const std::vector<int> merged =
+      AddSimilarityBlocks(energy.similarity(), secant, layout, k, problem);
+  std::vector<SmoothnessRows> rows = SmoothnessRowsOfEachGaussian(energy, k);
+  for (int s = 0; s < k->size(); ++s) {
+    SmoothnessRows& row = rows[s];
+    if (merged[s] >= 0) {
+      surface_gaussians_.emplace_back(energy.similarity(), merged[s], secant, row.prior_root,
+                                      std::move(row.neighbours), row.num_free());
+      problem->AddResidualBlock(&surface_gaussians_.back(), nullptr, row.parameter_blocks);
+    } else if (!row.empty()) {
+      smoothness_.emplace_back(row.prior_root, std::move(row.neighbours), row.num_free());
+      problem->AddResidualBlock(&smoothness_.back(), nullptr, row.parameter_blocks);
+    }
+  }
+}
+
+std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& term, bool secant,
+                                                         Layout layout, Eigen::VectorXd* k,
+                                                         ceres::Problem* problem) {
+  std::vector<int> merged(k->size(), -1);
+  std::vector<double*> parameter_blocks;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    const std::vector<int>& parameters = term.residual_blocks()[b].parameters;
+    if (layout == Layout::kPerGaussian && parameters.size() == 1 && merged[parameters[0]] < 0) {
+      merged[parameters[0]] = b;
+      continue;
+    }
+    parameter_blocks.clear();
+    for (int s : parameters) parameter_blocks.push_back(&(*k)[s]);
+    similarity_.emplace_back(term, b, secant);
+    problem->AddResidualBlock(&similarity_.back(), nullptr, parameter_blocks);
+  }
+  return merged;
 }
 
 }  // namespace finecap

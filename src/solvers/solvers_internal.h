@@ -8,12 +8,15 @@
 #include <ceres/iteration_callback.h>
 
 #include "finecap/solvers/solver.h"
+#include "solvers/ceres_cost_functions.h"
 
 namespace finecap {
 namespace internal {
 
+// `layout`: how the residual blocks reach Ceres; the same steps either way, to rounding.
 void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
-                    SolverSummary* summary);
+                    SolverSummary* summary,
+                    FrameCostFunctions::Layout layout = FrameCostFunctions::Layout::kPerGaussian);
 void SolveWithGradientAscent(const FrameEnergy& energy, const SolverOptions& options,
                              Eigen::VectorXd* k, SolverSummary* summary);
 void SolveWithLbfgs(const FrameEnergy& energy, const SolverOptions& options, Eigen::VectorXd* k,

@@ -2,7 +2,8 @@
 // same statistics, so that experiments can set them side by side:
 //
 //  * "ceres" (default): the least-squares form, the similarity's residual blocks plus one linear
-//    residual per pair of neighbours, with hand-written Jacobians; Levenberg-Marquardt with
+//    residual per pair of neighbours (one residual block per surface Gaussian holding both where
+//    its similarity block has one parameter), with hand-written Jacobians; Levenberg-Marquardt with
 //    conjugate gradients on the normal equations (or a sparse Cholesky factorisation); each k_s a
 //    bounded 1-D parameter block; the shared work of an evaluation done once in a
 //    ceres::EvaluationCallback; a block of one parameter modelled with the secant curvature of
