@@ -208,8 +208,11 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
     const double step = 2.0 * options.k_max / (num_nodes - 1);
     int compared = 0;
     for (int c = 0; c < static_cast<int>(energy.views().size()); ++c) {
-      // The energy released its pair lists once the tables were built: the same lists again.
+      // The energy released its pair lists and let go of the image Gaussians once the tables
+      // were built: the same lists again, over the camera's image Gaussians.
       EnergyView view = energy.views()[c];
+      EXPECT_EQ(view.image, nullptr);
+      view.image = scene.cameras[c].image;
       view.pairs = BuildCameraPairs(view.camera, *view.image, energy.surface(),
                                     scene.cameras[c].visible, EnergyPairOptions(options));
       ASSERT_EQ(view.pairs.surface_ids, energy.views()[c].pairs.surface_ids);
@@ -238,7 +241,8 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
 // A plain surface (every image Gaussian the same colour) gives the consensus nothing to agree
 // on: no weight, no residual, no pull anywhere.
 // The consensus similarity reads only its tables once built, so the energy keeps no image
-// Gaussian ids of its pairs, but counts them; a similarity that reads its pairs keeps them.
+// Gaussian ids of its pairs, but counts them, and no image Gaussians; a similarity that reads its
+// pairs keeps both.
 TEST(FrameEnergyTest, ReleasesThePairListsOfASimilarityThatDoesNotReadThem) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
   for (const std::string similarity : {"consensus", "surface_color"}) {
@@ -250,6 +254,10 @@ TEST(FrameEnergyTest, ReleasesThePairListsOfASimilarityThatDoesNotReadThem) {
                                 scene.cameras[c].visible, EnergyPairOptions(options))
                    .num_pairs();
       kept += energy.views()[c].pairs.num_pairs();
+      // Nor does it refer to the image Gaussians, which may then go (PreparedFrame::images).
+      EXPECT_EQ(energy.views()[c].image,
+                similarity == "consensus" ? nullptr : scene.cameras[c].image)
+          << similarity;
     }
     EXPECT_GT(pairs, 0) << similarity;
     EXPECT_EQ(energy.num_pairs(), pairs) << similarity;

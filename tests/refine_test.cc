@@ -41,6 +41,9 @@ TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
   EXPECT_DOUBLE_EQ(scheduled.summary.energy_start, single.summary.energy_start);
   options.coarse_to_fine.levels = 1;
   PreparedFrame configured = PrepareFrame(model, colors, input, options);
+  // The consensus similarity's tables hold what its energy needs of the image models.
+  EXPECT_TRUE(configured.images.empty());
+  EXPECT_GT(configured.num_image_gaussians, 0);
   EXPECT_NEAR(configured.energy->Evaluate(scheduled.k_solved, nullptr),
               scheduled.summary.energy_end, 1e-9 * std::abs(scheduled.summary.energy_end));
   EXPECT_GT(scheduled.summary.energy_end, scheduled.summary.energy_start);

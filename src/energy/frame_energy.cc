@@ -97,6 +97,7 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
     if (similarity_->ReadsPairLists()) continue;
     std::vector<int>().swap(view.pairs.image_ids);
     std::vector<float>().swap(view.pairs.color_weights);
+    view.image = nullptr;  // Without the ids nothing leads to the image Gaussians.
   }
 }
 

@@ -156,6 +156,8 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   }
   frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
                                                options.energy);
+  if (!frame.energy->similarity().ReadsPairLists())
+    std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
   return frame;
 }

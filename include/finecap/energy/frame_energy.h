@@ -42,8 +42,9 @@ class FrameEnergy {
   int num_parameters() const { return surface_.size(); }
   const SurfaceGaussians& surface() const { return surface_; }
   const EnergyOptions& options() const { return options_; }
-  // The cameras' pair lists, without their image Gaussian ids when the similarity does not read
-  // them after it is built (SimilarityTerm::ReadsPairLists).
+  // The cameras' pair lists, without their image Gaussian ids, and without the image Gaussians
+  // themselves (EnergyView::image null), when the similarity does not read them after it is built
+  // (SimilarityTerm::ReadsPairLists): the image models may then go.
   const std::vector<EnergyView>& views() const { return views_; }
   SimilarityTerm& similarity() { return *similarity_; }
   const SimilarityTerm& similarity() const { return *similarity_; }

@@ -179,9 +179,13 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 // A frame made ready to solve: its fine mesh, the image Gaussians and the energy over them.
 struct PreparedFrame {
-  Mesh fine;                            // The subdivided input mesh.
-  Eigen::Matrix3Xd normals;             // Its unit normals, along which k displaces.
-  std::vector<ImageGaussians> images;   // One per camera; the energy refers to them.
+  Mesh fine;                 // The subdivided input mesh.
+  Eigen::Matrix3Xd normals;  // Its unit normals, along which k displaces.
+  // One per camera, while the energy refers to them: none once it is built when its similarity
+  // reads no pair list after (SimilarityTerm::ReadsPairLists; the consensus similarity's tables
+  // hold what it needs), which spares a frame's image models (~7 MB on synth_skirt) while it is
+  // solved and while the next one waits.
+  std::vector<ImageGaussians> images;
   std::unique_ptr<FrameEnergy> energy;  // Over the surface Gaussians of the refined vertices.
   // The plane sweep's start over `energy` (SweepInitialization), when it was found ahead of the
   // solve (PrepareFrameAhead); empty otherwise.
