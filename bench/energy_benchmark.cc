@@ -1,6 +1,7 @@
 // One evaluation of the energy and its gradient on a synth_skirt frame (10k surface Gaussians,
 // 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads; and the
-// preparation of a frame (subdivision, visibility, image Gaussians, pair lists); and reading a
+// preparation of a frame (subdivision, visibility, image Gaussians, pair lists); one solve of it;
+// and reading a
 // frame's input (the coarse mesh and every camera's image, decoded and undistorted).
 //
 //   build/energy_benchmark [--benchmark_repetitions=5]
@@ -19,6 +20,7 @@
 #include "finecap/io/capture.h"
 #include "finecap/refine/frame_reader.h"
 #include "finecap/refine/refine.h"
+#include "finecap/solvers/solver.h"
 #include "finecap/solvers/sweep.h"
 
 namespace finecap {
@@ -98,6 +100,44 @@ void BM_SweepInitialization(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SweepInitialization)->Unit(benchmark::kMillisecond);
+
+// One evaluation with its gradient on one thread where the solve starts (the plane sweep's k):
+// the tables read at a spread of displacements, not all at one.
+void BM_EnergyAndGradientAtSweep(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const RefineOptions options;
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
+  Eigen::VectorXd gradient;
+  omp_set_num_threads(1);
+  for (auto _ : state) benchmark::DoNotOptimize(frame.energy->Evaluate(k, &gradient));
+  omp_set_num_threads(omp_get_num_procs());
+}
+BENCHMARK(BM_EnergyAndGradientAtSweep)->Unit(benchmark::kMillisecond);
+
+// One solve of a prepared frame with Ceres and the linear solver named, from the plane sweep's
+// start, as the first of a frame's passes: the solver's own work around the evaluations, beside
+// BM_EnergyAndGradient's evaluation alone. Real time: the solve runs on all threads.
+void BM_Solve(benchmark::State& state, const std::string& linear_solver) {
+  const SkirtFrame& skirt = Skirt();
+  RefineOptions options;
+  StringToEnum(linear_solver, &options.solver.linear_solver);
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd start = SweepInitialization(frame.energy.get(), options.sweep);
+  int evaluations = 0;
+  for (auto _ : state) {
+    Eigen::VectorXd k = start;
+    evaluations = Solve(frame.energy.get(), options.solver, &k).evaluations;
+    benchmark::DoNotOptimize(k.data());
+  }
+  state.counters["evaluations"] = evaluations;
+}
+BENCHMARK_CAPTURE(BM_Solve, cgnr, std::string("cgnr"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Solve, sparse_normal_cholesky, std::string("sparse_normal_cholesky"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_PrepareFrame(benchmark::State& state) {
   const SkirtFrame& skirt = Skirt();

@@ -20,12 +20,10 @@ void MeshBuilder::AddVertex(double x, double y, double z) {
   coordinates_.insert(coordinates_.end(), {x, y, z});
 }
 
-void MeshBuilder::AddFace(const std::vector<int>& corners, const std::string& where) {
-  Require(corners.size() == 3, where,
-          "a face with " + std::to_string(corners.size()) +
-              " corners: only triangles are read (triangulate the sequence beforehand, the same "
-              "way in every frame)");
-  corners_.insert(corners_.end(), corners.begin(), corners.end());
+std::string MeshBuilder::NonTriangleProblem(size_t num_corners) {
+  return "a face with " + std::to_string(num_corners) +
+         " corners: only triangles are read (triangulate the sequence beforehand, the same way "
+         "in every frame)";
 }
 
 Mesh MeshBuilder::Build() const {
@@ -83,7 +81,7 @@ Mesh ReadWithAssimp(const std::string& path) {
   for (unsigned int f = 0; f < source->mNumFaces; ++f) {
     const aiFace& face = source->mFaces[f];
     builder.AddFace(std::vector<int>(face.mIndices, face.mIndices + face.mNumIndices),
-                    path + " (face " + std::to_string(f) + ")");
+                    [&] { return path + " (face " + std::to_string(f) + ")"; });
   }
   return builder.Build();
 }

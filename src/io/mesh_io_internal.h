@@ -7,6 +7,7 @@
 
 #include "finecap/geometry/mesh.h"
 #include "finecap/io/mesh_io.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace internal {
@@ -17,13 +18,20 @@ class MeshBuilder {
   explicit MeshBuilder(std::string path) : path_(std::move(path)) {}
 
   void AddVertex(double x, double y, double z);
-  // `corners` are 0-based vertex ids; `where` locates the face in the file for error messages.
-  // A face with other than three corners is refused.
-  void AddFace(const std::vector<int>& corners, const std::string& where);
+  // `corners` are 0-based vertex ids. A face with other than three corners is refused, in an
+  // error located by `where()` (the face's place in the file), which is called only then: a
+  // string built for each of a mesh's faces would cost more than reading them.
+  template <typename Where>
+  void AddFace(const std::vector<int>& corners, const Where& where) {
+    if (corners.size() != 3) throw Error(where(), NonTriangleProblem(corners.size()));
+    corners_.insert(corners_.end(), corners.begin(), corners.end());
+  }
   int num_vertices() const { return static_cast<int>(coordinates_.size() / 3); }
   Mesh Build() const;
 
  private:
+  static std::string NonTriangleProblem(size_t num_corners);
+
   std::string path_;
   std::vector<double> coordinates_;
   std::vector<int> corners_;

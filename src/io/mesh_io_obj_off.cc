@@ -66,7 +66,7 @@ Mesh ParseObj(const std::string& contents, const std::string& path) {
       for (size_t c = 1; c < tokens.size(); ++c) {
         corners.push_back(ParseObjCorner(tokens[c], builder.num_vertices(), where));
       }
-      builder.AddFace(corners, where);
+      builder.AddFace(corners, [&] { return where; });
     } else {
       Require(kIgnoredObjStatements.count(tokens[0]) > 0, where,
               "'" + tokens[0] + "' is not an OBJ statement: not an OBJ mesh");
@@ -114,7 +114,7 @@ Mesh ParseOff(const std::string& contents, const std::string& path) {
     for (int c = 0; c < count; ++c) {
       Require(ParseInt(face[1 + c], &corners[c]), where, "'" + face[1 + c] + "' is not an index");
     }
-    builder.AddFace(corners, where);
+    builder.AddFace(corners, [&] { return where; });
   }
   return builder.Build();
 }

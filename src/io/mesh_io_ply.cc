@@ -218,29 +218,47 @@ int FindProperty(const PlyElement& element, const std::vector<std::string>& name
   return -1;
 }
 
+// Where instance `index` of `element` lies in the file at `path`, for error messages: built only
+// for an error, not for each of a mesh's many instances.
+struct InstanceLocation {
+  const std::string& path;
+  const PlyElement& element;
+  size_t index;
+  std::string operator()() const {
+    return path + " (" + element.name + " " + std::to_string(index) + ")";
+  }
+};
+
 // Reads one instance of `element`: the scalar properties into `scalars`, the list named by
 // `list_index` (if any) into `list`. Other lists are read and dropped.
 void ReadInstance(const PlyElement& element, int list_index, PlyValueReader* reader,
-                  const std::string& where, std::vector<double>* scalars, std::vector<int>* list) {
+                  const InstanceLocation& where, std::vector<double>* scalars,
+                  std::vector<int>* list) {
   scalars->assign(element.properties.size(), 0.0);
   list->clear();
+  const auto read = [&](PlyType type, double* value) {
+    if (!reader->Read(type, value)) {
+      throw Error(where(), "the data ends early or holds a value that is not a number");
+    }
+  };
   for (size_t p = 0; p < element.properties.size(); ++p) {
     const PlyProperty& property = element.properties[p];
     double value = 0.0;
-    Require(reader->Read(property.is_list ? property.count_type : property.type, &value), where,
-            "the data ends early or holds a value that is not a number");
+    read(property.is_list ? property.count_type : property.type, &value);
     if (!property.is_list) {
       (*scalars)[p] = value;
       continue;
     }
-    Require(value >= 0 && value <= 1e6 && value == std::floor(value), where, "invalid list length");
+    if (!(value >= 0 && value <= 1e6 && value == std::floor(value))) {
+      throw Error(where(), "invalid list length");
+    }
     for (int i = 0; i < static_cast<int>(value); ++i) {
       double item = 0.0;
-      Require(reader->Read(property.type, &item), where,
-              "the data ends early or holds a value that is not a number");
+      read(property.type, &item);
       if (static_cast<int>(p) != list_index) continue;
-      Require(item == std::floor(item) && std::abs(item) < 2e9, where,
-              "vertex index is not an integer");
+      if (!(item == std::floor(item) && std::abs(item) < 2e9)) {
+        throw Error(where(), "vertex index is not an integer");
+      }
       list->push_back(static_cast<int>(item));
     }
   }
@@ -263,7 +281,7 @@ void ReadElement(const PlyElement& element, PlyValueReader* reader, const std::s
   std::vector<double> scalars;
   std::vector<int> list;
   for (size_t i = 0; i < element.count; ++i) {
-    const std::string where = path + " (" + element.name + " " + std::to_string(i) + ")";
+    const InstanceLocation where{path, element, i};
     ReadInstance(element, is_face ? indices : -1, reader, where, &scalars, &list);
     if (is_vertex) builder->AddVertex(scalars[x], scalars[y], scalars[z]);
     if (is_face) builder->AddFace(list, where);
