@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "finecap/util/error.h"
+#include "io/png_decode.h"
 #include "util/io_util.h"
 
 namespace finecap {
@@ -45,6 +46,15 @@ cv::Mat DecodeImageFile(const std::string& path) {
   Require(!IsJpeg(bytes) || JpegHasEndMarker(bytes), path,
           "the JPEG image is truncated (no end marker)");
   cv::Mat image;
+  std::string problem;
+  switch (internal::DecodeCommonPng(bytes, &image, &problem)) {
+    case internal::PngDecodeResult::kDecoded:
+      return image;
+    case internal::PngDecodeResult::kDamaged:
+      throw Error(path, "cannot decode the image: " + problem);
+    case internal::PngDecodeResult::kUnsupported:
+      break;  // OpenCV's decoders read every other kind.
+  }
   try {
     image = cv::imdecode(
         cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())),
