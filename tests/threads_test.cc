@@ -26,6 +26,38 @@ int ThreadsOfAParallelRegion() {
   return threads;
 }
 
+TEST(ParallelForTest, RunsEveryIndexOnce) {
+  std::vector<int> runs(37, 0);
+  ParallelFor(static_cast<int>(runs.size()), [&](int i) { ++runs[i]; });
+  EXPECT_EQ(runs, std::vector<int>(runs.size(), 1));
+  ParallelFor(0, [](int) { FAIL() << "no index to run"; });
+}
+
+TEST(ParallelForTest, KeepsEachFailureAtItsIndex) {
+  std::vector<int> ran(8, 0);
+  const std::vector<std::exception_ptr> failures = ParallelForKeepingFailures(8, [&](int i) {
+    ran[i] = 1;
+    if (i % 3 == 1) throw Error("camera " + std::to_string(i), "unreadable");
+  });
+  ASSERT_EQ(failures.size(), 8u);
+  EXPECT_EQ(ran, std::vector<int>(8, 1));  // A failure does not stop the others.
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(failures[i] != nullptr, i % 3 == 1) << i;
+}
+
+TEST(ParallelForTest, RethrowsTheFailureOfTheLowestIndex) {
+  // Whichever thread fails first, the error is the one a loop in order would meet first.
+  for (int repeat = 0; repeat < 20; ++repeat) {
+    try {
+      ParallelFor(16, [](int i) {
+        if (i >= 5) throw Error("camera " + std::to_string(i), "unreadable");
+      });
+      FAIL() << "nothing thrown";
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find("camera 5:"), std::string::npos) << error.what();
+    }
+  }
+}
+
 TEST(SetWorkerThreadsTest, LimitsTheOpenMpStagesAndRestoresTheDefault) {
   const int default_threads = omp_get_max_threads();
   SetWorkerThreads(1);

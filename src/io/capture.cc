@@ -13,6 +13,7 @@
 #include "finecap/io/mesh_io.h"
 #include "finecap/io/vertex_mask.h"
 #include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 #include "util/io_util.h"
 
 namespace finecap {
@@ -134,20 +135,9 @@ void Capture::OpenFrameSources() {
   }
   // Decodes and checks the first image of each camera, the cameras side by side; a failure is
   // reported as the cameras taken in the rig's order would meet it.
-  const int num_sources = static_cast<int>(sources_.size());
-  first_images_.resize(num_sources);
-  std::vector<std::exception_ptr> failures(num_sources);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int c = 0; c < num_sources; ++c) {
-    try {
-      first_images_[c] = sources_[c]->Read(0);
-    } catch (...) {
-      failures[c] = std::current_exception();
-    }
-  }
-  for (const std::exception_ptr& failure : failures) {
-    if (failure) std::rethrow_exception(failure);
-  }
+  first_images_.resize(sources_.size());
+  ParallelFor(static_cast<int>(sources_.size()),
+              [this](int c) { first_images_[c] = sources_[c]->Read(0); });
 }
 
 void Capture::ReadOptionalFiles() {

@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 #include "util/option_checks.h"
 
 namespace finecap {
@@ -533,21 +534,9 @@ std::vector<ImageGaussians> BuildFrameImageGaussians(const std::vector<cv::Mat>&
   };
   for (size_t i = 0; i < images.size(); ++i) CheckImageAndMask(images[i], mask_of(i), names[i]);
 
-  // Exceptions may not leave an OpenMP region: keep each, rethrow the first afterwards.
-  const int count = static_cast<int>(images.size());
-  std::vector<ImageGaussians> result(count);
-  std::vector<std::exception_ptr> failures(count);
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int i = 0; i < count; ++i) {
-    try {
-      result[i] = BuildChecked(images[i], mask_of(i), options, names[i]);
-    } catch (...) {
-      failures[i] = std::current_exception();
-    }
-  }
-  for (const std::exception_ptr& failure : failures) {
-    if (failure) std::rethrow_exception(failure);
-  }
+  std::vector<ImageGaussians> result(images.size());
+  ParallelFor(static_cast<int>(images.size()),
+              [&](int i) { result[i] = BuildChecked(images[i], mask_of(i), options, names[i]); });
   return result;
 }
 

@@ -7,9 +7,21 @@
 #include <omp.h>
 
 #include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 
 namespace finecap {
 namespace {
+
+// The message of `failure` when it is an Error (a problem with the input), else empty.
+std::string ErrorMessage(const std::exception_ptr& failure) {
+  try {
+    std::rethrow_exception(failure);
+  } catch (const Error& error) {
+    return error.what();
+  } catch (...) {
+    return "";
+  }
+}
 
 // The calling thread's OpenMP threads for parallel regions, `threads` while in scope.
 class ScopedOpenMpThreads {
@@ -39,19 +51,8 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
   // failures are then taken in the rig's order, as one camera after the other would meet them.
   const int num_cameras = capture->num_cameras();
   std::vector<cv::Mat> images(num_cameras);
-  std::vector<std::exception_ptr> failures(num_cameras);
-  std::vector<std::string> errors(num_cameras);  // The message of a failure that is an Error.
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int c = 0; c < num_cameras; ++c) {
-    try {
-      images[c] = capture->ReadImage(c, frame);
-    } catch (const Error& error) {
-      failures[c] = std::current_exception();
-      errors[c] = error.what();
-    } catch (...) {
-      failures[c] = std::current_exception();
-    }
-  }
+  const std::vector<std::exception_ptr> failures = ParallelForKeepingFailures(
+      num_cameras, [&](int c) { images[c] = capture->ReadImage(c, frame); });
   std::string first_error;
   for (int c = 0; c < num_cameras; ++c) {
     const Camera& camera = capture->cameras()[c];
@@ -60,9 +61,11 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
       input.cameras.push_back(camera);
       continue;
     }
-    if (!skip_unreadable || errors[c].empty()) std::rethrow_exception(failures[c]);
-    if (first_error.empty()) first_error = errors[c];
-    if (skipped != nullptr) skipped->push_back({camera.name, errors[c]});
+    // Only a camera whose image is unreadable (an Error) may be skipped, not a program fault.
+    const std::string error = ErrorMessage(failures[c]);
+    if (!skip_unreadable || error.empty()) std::rethrow_exception(failures[c]);
+    if (first_error.empty()) first_error = error;
+    if (skipped != nullptr) skipped->push_back({camera.name, error});
   }
   Require(!input.cameras.empty(), "",
           first_error + " (and no other camera's image of frame " + capture->frame_name(frame) +

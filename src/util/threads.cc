@@ -3,6 +3,7 @@
 #include <malloc.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "finecap/util/error.h"
@@ -22,5 +23,25 @@ void PreferSleepingWorkers() {
 }
 
 void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }
+
+std::vector<std::exception_ptr> ParallelForKeepingFailures(int count,
+                                                           const std::function<void(int)>& task) {
+  std::vector<std::exception_ptr> failures(std::max(count, 0));
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int i = 0; i < count; ++i) {
+    try {
+      task(i);
+    } catch (...) {
+      failures[i] = std::current_exception();
+    }
+  }
+  return failures;
+}
+
+void ParallelFor(int count, const std::function<void(int)>& task) {
+  for (const std::exception_ptr& failure : ParallelForKeepingFailures(count, task)) {
+    if (failure) std::rethrow_exception(failure);
+  }
+}
 
 }  // namespace finecap
