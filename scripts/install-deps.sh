@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libceres-dev libsuitesparse-dev
   libopencv-dev libopencv-contrib-dev libassimp-dev
+  libpng-dev libjpeg62-turbo-dev  # finecap's own PNG and JPEG codecs (src/util/image_codec.h)
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox clang-format libjs-three
