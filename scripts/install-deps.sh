@@ -6,7 +6,8 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libceres-dev libsuitesparse-dev
-  libopencv-dev libopencv-contrib-dev libassimp-dev libdeflate-dev
+  libopencv-dev libopencv-contrib-dev libassimp-dev
+  libpng-dev libjpeg62-turbo-dev libdeflate-dev  # finecap's own PNG and JPEG codecs (util)
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   gnuplot-nox clang-format libjs-three

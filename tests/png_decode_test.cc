@@ -1,4 +1,4 @@
-#include "io/png_decode.h"
+#include "util/png_decode.h"
 
 #include <libdeflate.h>
 

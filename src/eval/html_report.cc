@@ -5,10 +5,9 @@
 #include <cstdint>
 #include <cstdio>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
+#include "util/image_codec.h"
 #include "util/io_util.h"
 
 namespace finecap {
@@ -153,9 +152,7 @@ void HtmlReport::AddImage(const cv::Mat& image, const std::string& caption) {
           Where(),
           "an image to embed must be 8- or 16-bit with 1, 3 or 4 channels, not type " +
               cv::typeToString(image.type()));
-  std::vector<uchar> png;
-  Require(cv::imencode(".png", image, png), Where(), "cannot encode an image as PNG");
-  AddEmbeddedImage("image/png", std::string(png.begin(), png.end()), caption);
+  AddEmbeddedImage("image/png", internal::EncodePng(image, Where()), caption);
 }
 
 void HtmlReport::AddRawHtml(const std::string& html) { body_ += html; }

@@ -4,10 +4,10 @@
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
-#include <opencv2/optflow.hpp>
 #include <opencv2/video/tracking.hpp>
 
 #include "finecap/util/error.h"
+#include "util/opencv_extras.h"
 #include "util/option_checks.h"
 
 namespace finecap {
@@ -60,13 +60,11 @@ cv::Mat ComputeOpticalFlow(const cv::Mat& from, const cv::Mat& to,
   RequireFlowImage(from, where, "the first");
   RequireFlowImage(to, where, "the second");
   Require(from.size() == to.size(), where, "the two images differ in size");
-  const cv::Ptr<cv::DenseOpticalFlow> method =
-      options.method == FlowMethod::kDeepFlow
-          ? cv::optflow::createOptFlow_DeepFlow()
-          : cv::Ptr<cv::DenseOpticalFlow>(
-                cv::DISOpticalFlow::create(OpenCvPreset(options.dis_preset)));
+  if (options.method == FlowMethod::kDeepFlow) {
+    return internal::LoadOpenCvExtras("optical flow by DeepFlow").deep_flow(Grey(from), Grey(to));
+  }
   cv::Mat flow;
-  method->calc(Grey(from), Grey(to), flow);
+  cv::DISOpticalFlow::create(OpenCvPreset(options.dis_preset))->calc(Grey(from), Grey(to), flow);
   return flow;
 }
 

@@ -6,13 +6,12 @@
 #include <map>
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "finecap/util/error.h"
-#include "io/png_decode.h"
+#include "util/image_codec.h"
 #include "util/io_util.h"
+#include "util/opencv_extras.h"
 
 namespace finecap {
 namespace {
@@ -45,25 +44,7 @@ cv::Mat DecodeImageFile(const std::string& path) {
   Require(!bytes.empty(), path, "the image file is empty (0 bytes)");
   Require(!IsJpeg(bytes) || JpegHasEndMarker(bytes), path,
           "the JPEG image is truncated (no end marker)");
-  cv::Mat image;
-  std::string problem;
-  switch (internal::DecodeCommonPng(bytes, &image, &problem)) {
-    case internal::PngDecodeResult::kDecoded:
-      return image;
-    case internal::PngDecodeResult::kDamaged:
-      throw Error(path, "cannot decode the image: " + problem);
-    case internal::PngDecodeResult::kUnsupported:
-      break;  // OpenCV's decoders read every other kind.
-  }
-  try {
-    image = cv::imdecode(
-        cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<char*>(bytes.data())),
-        cv::IMREAD_COLOR);
-  } catch (const cv::Exception& error) {
-    throw Error(path, "cannot decode the image: " + error.msg);
-  }
-  Require(!image.empty(), path, "cannot decode the image (truncated, damaged or not an image)");
-  return image;
+  return internal::DecodeImage(bytes, path);
 }
 
 bool IsImageExtension(std::string extension) {
@@ -175,6 +156,16 @@ class ImageFolderSource : public FrameSource {
   Undistorter undistorter_;
 };
 
+// The video at `path` through the OpenCV extras (src/util/opencv_extras.h), which are loaded
+// here, by the first video a run opens.
+std::unique_ptr<internal::VideoReader> OpenVideo(const std::string& path) {
+  internal::RequireFile(path);
+  std::unique_ptr<internal::VideoReader> video =
+      internal::LoadOpenCvExtras("video input (" + path + ")").open_video(path);
+  Require(video != nullptr, path, "cannot be opened as a video");
+  return video;
+}
+
 // Forward jumps up to this many frames decode the frames in between instead of seeking: exact
 // for every codec, and cheaper than a seek to the previous key frame.
 constexpr int kMaxFramesDecodedToSkip = 32;
@@ -182,16 +173,17 @@ constexpr int kMaxFramesDecodedToSkip = 32;
 class VideoSource : public FrameSource {
  public:
   VideoSource(const std::string& path, int num_frames, const Camera& camera)
-      : path_(path), num_frames_(num_frames), camera_(camera), undistorter_(camera) {
-    internal::RequireFile(path);
-    Require(capture_.open(path), path, "cannot be opened as a video");
-  }
+      : path_(path),
+        num_frames_(num_frames),
+        camera_(camera),
+        undistorter_(camera),
+        capture_(OpenVideo(path)) {}
 
   cv::Mat Read(int frame) override {
     RequireFrameInRange(frame, num_frames_, path_);
     MoveTo(frame);
     cv::Mat image;
-    Require(capture_.read(image) && !image.empty(), path_, TooShort(frame));
+    Require(capture_->Read(&image) && !image.empty(), path_, TooShort(frame));
     next_frame_ = frame + 1;
     RequireCameraSize(image, camera_, path_ + " (frame " + std::to_string(frame) + ")");
     return undistorter_.Apply(image);
@@ -202,11 +194,11 @@ class VideoSource : public FrameSource {
  private:
   void MoveTo(int frame) {
     if (frame < next_frame_ || frame > next_frame_ + kMaxFramesDecodedToSkip) {
-      capture_.set(cv::CAP_PROP_POS_FRAMES, frame);
+      capture_->Seek(frame);
       next_frame_ = frame;
     }
     for (; next_frame_ < frame; ++next_frame_) {
-      Require(capture_.grab(), path_, TooShort(next_frame_));
+      Require(capture_->Grab(), path_, TooShort(next_frame_));
     }
   }
 
@@ -219,8 +211,8 @@ class VideoSource : public FrameSource {
   int num_frames_;
   Camera camera_;
   Undistorter undistorter_;
-  cv::VideoCapture capture_;
-  int next_frame_ = 0;  // The frame the next capture_.read() returns.
+  std::unique_ptr<internal::VideoReader> capture_;
+  int next_frame_ = 0;  // The frame the next capture_->Read() returns.
 };
 
 }  // namespace
@@ -253,11 +245,8 @@ cv::Size ReadFirstFrameSize(const std::string& path, const std::vector<std::stri
   if (fs::is_directory(path, error)) {
     return DecodeImageFile(ImageFolderIndex(path).Find(frame_names[0])).size();
   }
-  internal::RequireFile(path);
-  cv::VideoCapture capture;
   cv::Mat image;
-  Require(capture.open(path), path, "cannot be opened as a video");
-  Require(capture.read(image) && !image.empty(), path, "the video has no frames");
+  Require(OpenVideo(path)->Read(&image) && !image.empty(), path, "the video has no frames");
   return image.size();
 }
 

@@ -12,10 +12,9 @@
 #include <limits>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
+#include "util/image_codec.h"
 
 namespace finecap {
 namespace internal {
@@ -95,13 +94,7 @@ std::string JsonNumber(double value) {
 }
 
 void WritePng(const std::string& path, const cv::Mat& image) {
-  std::vector<uchar> buffer;
-  try {
-    Require(cv::imencode(".png", image, buffer), path, "cannot encode the image as PNG");
-  } catch (const cv::Exception& error) {
-    throw Error(path, std::string("cannot encode the image as PNG: ") + error.what());
-  }
-  WriteTextFileAtomically(path, std::string(buffer.begin(), buffer.end()));
+  WriteTextFileAtomically(path, EncodePng(image, path));
 }
 
 }  // namespace internal

@@ -29,7 +29,9 @@ class FrameSource {
   virtual int num_frames() const = 0;
 };
 
-// Frame i is the image `folder`/<frame_names[i]>.png (or .jpg, .jpeg; extension case ignored).
+// Frame i is the image `folder`/<frame_names[i]>.png (or .jpg, .jpeg; extension case ignored),
+// read as its pixels are stored (an EXIF orientation tag is ignored: the camera is calibrated on
+// those pixels).
 // When no file has exactly that stem and the frame name is a number, an image whose stem is the
 // same number (`12.png` for frame `000012`) is taken. The folder is listed once, here; a frame
 // without an image is reported when it is read.
@@ -38,8 +40,10 @@ std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
                                                    const Camera& camera);
 
 // Frame i is the i-th frame of the video at `path` (anything cv::VideoCapture opens), for
-// `num_frames` frames. Frames asked in increasing order are decoded sequentially (skipping
-// forward up to 32 frames by decoding them); any other jump seeks with CAP_PROP_POS_FRAMES.
+// `num_frames` frames. OpenCV's video input is loaded here, on the first video opened, from
+// libfinecap_opencv_extras.so; Error names that library when it cannot be loaded. Frames asked in
+// increasing order are decoded sequentially (skipping forward up to 32 frames by decoding them);
+// any other jump seeks with CAP_PROP_POS_FRAMES.
 std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,
                                              const Camera& camera);
 

@@ -1,4 +1,4 @@
-#include "io/png_decode.h"
+#include "util/png_decode.h"
 
 #include <libdeflate.h>
 
@@ -58,14 +58,14 @@ PngDecodeResult ReadChunks(const std::string& bytes, Chunks* chunks, std::string
   bool has_header = false;
   while (true) {
     if (bytes.size() - position < 12) {
-      *problem = "the PNG file ends before its IEND chunk (truncated)";
+      *problem = "the PNG file ends early, before its IEND chunk (truncated)";
       return PngDecodeResult::kDamaged;
     }
     const uint32_t length = BigEndian32(begin + position);
     const std::string type(bytes, position + 4, 4);
     const unsigned char* data = begin + position + 8;
     if (length > bytes.size() - position - 12) {
-      *problem = "the PNG file ends inside its " + type + " chunk (truncated)";
+      *problem = "the PNG file ends early, inside its " + type + " chunk (truncated)";
       return PngDecodeResult::kDamaged;
     }
     position += 12 + size_t{length};
@@ -174,8 +174,8 @@ PngDecodeResult DecodeCommonPng(const std::string& bytes, cv::Mat* image, std::s
                                  raw.data(), raw.size(), &inflated);
   if (result != LIBDEFLATE_SUCCESS || inflated != expected) {
     *problem = result == LIBDEFLATE_SUCCESS || result == LIBDEFLATE_INSUFFICIENT_SPACE
-                   ? "the PNG image data does not hold the pixels its header promises"
-                   : "the PNG image data is damaged (it does not inflate)";
+                   ? "the PNG image data (IDAT) does not hold the pixels its header promises"
+                   : "the PNG image data (IDAT) is damaged (it does not inflate)";
     return PngDecodeResult::kDamaged;
   }
   *image = cv::Mat(static_cast<int>(header.height), static_cast<int>(header.width), CV_8UC3);

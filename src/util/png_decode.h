@@ -7,10 +7,11 @@
 // The result is what OpenCV's imdecode gives with IMREAD_COLOR: 8-bit BGR, grey replicated into
 // the three channels, alpha dropped (not composited), no gamma applied. Files of any other kind
 // (palette, 1/2/4 or 16 bits per channel, interlaced, an unknown critical chunk) are left to the
-// general decoder. Chunk checksums are not checked: the image data's own Adler-32 checksum, which
-// libdeflate checks, covers the pixels, and the other chunks' contents are not used.
-#ifndef FINECAP_SRC_IO_PNG_DECODE_H_
-#define FINECAP_SRC_IO_PNG_DECODE_H_
+// general decoder (libpng, image_codec.h). Chunk checksums are not checked: the image data's own
+// Adler-32 checksum, which libdeflate checks, covers the pixels, and the other chunks' contents are
+// not used.
+#ifndef FINECAP_SRC_UTIL_PNG_DECODE_H_
+#define FINECAP_SRC_UTIL_PNG_DECODE_H_
 
 #include <string>
 
@@ -31,4 +32,4 @@ PngDecodeResult DecodeCommonPng(const std::string& bytes, cv::Mat* image, std::s
 }  // namespace internal
 }  // namespace finecap
 
-#endif  // FINECAP_SRC_IO_PNG_DECODE_H_
+#endif  // FINECAP_SRC_UTIL_PNG_DECODE_H_
