@@ -69,42 +69,39 @@ MeshRayCaster::MeshRayCaster(const Mesh& mesh) : vertices_(mesh.vertices), faces
   Build(0, 0, mesh.num_faces(), centroids);
 }
 
-void MeshRayCaster::Build(int node, int begin, int end, const Eigen::Matrix3Xd& centroids) {
-  Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d upper = -lower;
-  Eigen::Vector3d centroid_lower = lower;
-  Eigen::Vector3d centroid_upper = upper;
-  for (int i = begin; i < end; ++i) {
-    for (int corner = 0; corner < 3; ++corner) {
-      const Eigen::Vector3d vertex = vertices_.col(faces_(corner, triangles_[i]));
-      lower = lower.cwiseMin(vertex);
-      upper = upper.cwiseMax(vertex);
-    }
-    centroid_lower = centroid_lower.cwiseMin(centroids.col(triangles_[i]));
-    centroid_upper = centroid_upper.cwiseMax(centroids.col(triangles_[i]));
-  }
-  // A little slack: a line through a vertex on the box's face must not be rounded out of it.
-  const double slack = 1e-9 * (upper - lower).maxCoeff() + 1e-12;
-  nodes_[node].lower = lower.array() - slack;
-  nodes_[node].upper = upper.array() + slack;
+Eigen::AlignedBox3d MeshRayCaster::Build(int node, int begin, int end,
+                                         const Eigen::Matrix3Xd& centroids) {
+  Eigen::AlignedBox3d bounds;
   if (end - begin <= kLeafSize) {
+    for (int i = begin; i < end; ++i) {
+      for (int corner = 0; corner < 3; ++corner) {
+        bounds.extend(vertices_.col(faces_(corner, triangles_[i])));
+      }
+    }
     nodes_[node].first = begin;
     nodes_[node].count = end - begin;
-    return;
+  } else {
+    Eigen::AlignedBox3d centroid_bounds;
+    for (int i = begin; i < end; ++i) centroid_bounds.extend(centroids.col(triangles_[i]));
+    int axis = 0;
+    centroid_bounds.sizes().maxCoeff(&axis);
+    const int middle = (begin + end) / 2;
+    std::nth_element(triangles_.begin() + begin, triangles_.begin() + middle,
+                     triangles_.begin() + end,
+                     [&](int a, int b) { return centroids(axis, a) < centroids(axis, b); });
+    const int children = static_cast<int>(nodes_.size());
+    nodes_.emplace_back();
+    nodes_.emplace_back();
+    nodes_[node].first = children;
+    nodes_[node].count = 0;
+    bounds = Build(children, begin, middle, centroids);
+    bounds.extend(Build(children + 1, middle, end, centroids));
   }
-  int axis = 0;
-  (centroid_upper - centroid_lower).maxCoeff(&axis);
-  const int middle = (begin + end) / 2;
-  std::nth_element(triangles_.begin() + begin, triangles_.begin() + middle,
-                   triangles_.begin() + end,
-                   [&](int a, int b) { return centroids(axis, a) < centroids(axis, b); });
-  const int children = static_cast<int>(nodes_.size());
-  nodes_.emplace_back();
-  nodes_.emplace_back();
-  nodes_[node].first = children;
-  nodes_[node].count = 0;
-  Build(children, begin, middle, centroids);
-  Build(children + 1, middle, end, centroids);
+  // A little slack: a line through a vertex on the box's face must not be rounded out of it.
+  const double slack = 1e-9 * bounds.sizes().maxCoeff() + 1e-12;
+  nodes_[node].lower = bounds.min().array() - slack;
+  nodes_[node].upper = bounds.max().array() + slack;
+  return bounds;
 }
 
 std::optional<double> MeshRayCaster::NearestHit(const Eigen::Vector3d& origin,

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "finecap/geometry/mesh.h"
 
@@ -34,8 +35,10 @@ class MeshRayCaster {
     int count = 0;  // Leaf: number of triangles; 0 for an inner node (right child = first + 1).
   };
 
-  // Fills node `node` with the triangles_[begin, end), splitting them recursively.
-  void Build(int node, int begin, int end, const Eigen::Matrix3Xd& centroids);
+  // Fills node `node` with the triangles_[begin, end), splitting them recursively, and returns
+  // the exact bounds of their vertices (the node's box is these plus a little slack). An inner
+  // node's bounds are its children's together: the vertices are read once, in the leaves.
+  Eigen::AlignedBox3d Build(int node, int begin, int end, const Eigen::Matrix3Xd& centroids);
 
   Eigen::Matrix3Xd vertices_;
   Eigen::Matrix3Xi faces_;
