@@ -10,6 +10,7 @@
 #include <ceres/problem.h>
 #include <gtest/gtest.h>
 
+#include "energy/consensus_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/util/error.h"
 #include "solvers/ceres_cost_functions.h"
@@ -228,6 +229,51 @@ TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
   ASSERT_GT((k_separate - start).norm(), 1e-3 * start.norm()) << "the solve did not move";
   EXPECT_LE((k_merged - k_separate).norm(), 1e-9 * k_separate.norm());
   EXPECT_NEAR(merged.ls_cost_end, separate.ls_cost_end, 1e-9 * separate.ls_cost_end);
+}
+
+// A FrameSolver keeps its Ceres problem from one pass to the next, while the consensus energy's
+// patch shape changes in between: each pass must take the steps of a problem built afresh (the
+// point prepared last and the secant histories, which belonged to the energy before, forgotten).
+TEST(FrameSolverTest, PassesOnOneProblemTakeTheStepsOfFreshProblems) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     Options("consensus", "exact"));
+  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy.similarity());
+  ASSERT_NE(consensus, nullptr);
+  Eigen::VectorXd start(energy.num_parameters());
+  for (int s = 0; s < start.size(); ++s) start[s] = 0.002 * std::sin(1.7 * s);
+  const Eigen::VectorXd flat = Eigen::VectorXd::Zero(start.size());
+  SolverOptions options;
+  options.max_iterations = 6;
+  options.function_tolerance = 1e-12;
+  options.num_threads = 2;
+
+  // Three passes: the input surface's patches, then patches shaped like the last result, twice.
+  auto passes = [&](bool one_problem, std::vector<SolverSummary>* summaries) {
+    Eigen::VectorXd k = start;
+    consensus->SetPatchShape(flat);
+    FrameSolver solver(&energy, options);
+    for (int pass = 0; pass < 3; ++pass) {
+      if (pass > 0) consensus->SetPatchShape(k);
+      summaries->push_back(one_problem ? solver.Solve(&k) : Solve(&energy, options, &k));
+    }
+    return k;
+  };
+  std::vector<SolverSummary> fresh, kept;
+  const Eigen::VectorXd k_fresh = passes(false, &fresh);
+  const Eigen::VectorXd k_kept = passes(true, &kept);
+  ASSERT_GT((k_fresh - start).norm(), 1e-3 * start.norm()) << "the solves did not move";
+  for (int pass = 0; pass < 3; ++pass) {
+    EXPECT_EQ(kept[pass].iterations, fresh[pass].iterations) << pass;
+    EXPECT_EQ(kept[pass].evaluations, fresh[pass].evaluations) << pass;
+    EXPECT_NEAR(kept[pass].ls_cost_start, fresh[pass].ls_cost_start,
+                1e-12 * fresh[pass].ls_cost_start)
+        << pass;
+    EXPECT_NEAR(kept[pass].ls_cost_end, fresh[pass].ls_cost_end, 1e-12 * fresh[pass].ls_cost_end)
+        << pass;
+  }
+  EXPECT_LE((k_kept - k_fresh).norm(), 1e-12 * k_fresh.norm());
+  consensus->SetPatchShape(flat);
 }
 
 // The problem Ceres is given (similarity blocks, one smoothness block per Gaussian) has the cost

@@ -196,7 +196,8 @@ namespace {
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k) {
   const Eigen::VectorXd start = *k;
-  SolverSummary summary = Solve(energy, options.solver, k);
+  FrameSolver solver(energy, options.solver);  // One Ceres problem for all the passes.
+  SolverSummary summary = solver.Solve(k);
   auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
   if (consensus == nullptr) return summary;
   for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
@@ -205,7 +206,7 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     energy->regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
                                                 &shape);
     consensus->SetPatchShape(shape.col(0));
-    const SolverSummary more = Solve(energy, options.solver, k);
+    const SolverSummary more = solver.Solve(k);
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;
     summary.iterations += more.iterations;

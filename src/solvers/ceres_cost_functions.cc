@@ -312,4 +312,9 @@ std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& t
   return merged;
 }
 
+void FrameCostFunctions::ForgetHistories() const {
+  for (const ReducedSimilarityBlockCost& cost : similarity_) cost.ForgetHistory();
+  for (const SurfaceGaussianCost& cost : surface_gaussians_) cost.ForgetHistory();
+}
+
 }  // namespace finecap

@@ -29,6 +29,9 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
  public:
   SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k, double* seconds);
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
+  // Forgets the point prepared last: the term has changed since (a further pass's patch shape),
+  // and its preparation at that point no longer holds.
+  void Forget() { prepared_.resize(0); }
 
  private:
   SimilarityTerm* term_;
@@ -87,6 +90,9 @@ class ReducedSimilarityBlockCost : public ceres::CostFunction {
   ReducedSimilarityBlockCost(const SimilarityTerm& term, int block, bool secant = false);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // Forgets the secant's history: gradients of a term that has changed since do not measure the
+  // curvature of the new one.
+  void ForgetHistory() const { has_last_ = false; }
 
  private:
   // The two residuals and Jacobian of a block of one parameter at k, from its summary.
@@ -164,6 +170,7 @@ class SurfaceGaussianCost : public ceres::CostFunction {
                       int num_free);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  void ForgetHistory() const { similarity_.ForgetHistory(); }
 
  private:
   ReducedSimilarityBlockCost similarity_;
@@ -185,6 +192,8 @@ class FrameCostFunctions {
   // each bounded by k_max. `secant`: CurvatureModel::kSecant.
   void AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout, Eigen::VectorXd* k,
                          ceres::Problem* problem);
+  // Forgets every similarity block's secant history (ReducedSimilarityBlockCost::ForgetHistory).
+  void ForgetHistories() const;
 
  private:
   // Adds the similarity blocks that stand alone; returns, for each surface Gaussian, the block

@@ -1,4 +1,5 @@
 // The least-squares form of the energy as a Ceres problem with hand-written Jacobians.
+#include <memory>
 #include <thread>
 
 #include <ceres/ceres.h>
@@ -63,28 +64,29 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
 
 }  // namespace
 
-void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
-                    SolverSummary* summary, FrameCostFunctions::Layout layout) {
-  const Stopwatch clock;
-  double seconds_shared = 0.0;
-  SharedEvaluationCallback shared(&energy->similarity(), k, &seconds_shared);
-  FrameCostFunctions cost_functions;  // Outlives the problem, which does not own them.
+CeresFrameProblem::CeresFrameProblem(FrameEnergy* energy, bool secant,
+                                     FrameCostFunctions::Layout layout, Eigen::VectorXd* k)
+    : k_(k), shared_(&energy->similarity(), k, &seconds_shared_) {
   ceres::Problem::Options problem_options;
-  problem_options.evaluation_callback = &shared;
+  problem_options.evaluation_callback = &shared_;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Ceres' checks as the problem is built stay on: disable_all_safety_checks saved ~0.1 of the
   // ~11 ms that building and destroying a synth_skirt problem takes.
-  ceres::Problem problem(problem_options);
-  cost_functions.AddResidualBlocks(*energy, options.curvature == CurvatureModel::kSecant, layout, k,
-                                   &problem);
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+  cost_functions_.AddResidualBlocks(*energy, secant, layout, k, problem_.get());
+}
 
+void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clock,
+                              SolverSummary* summary) {
+  shared_.Forget();
+  cost_functions_.ForgetHistories();
   ceres::Solver::Options ceres_options = MakeCeresOptions(options);
   TraceRecorder recorder(clock, summary);
   ceres_options.callbacks.push_back(&recorder);
   StopOnSmallDecrease stop(options.function_tolerance);
   ceres_options.callbacks.push_back(&stop);
   ceres::Solver::Summary ceres_summary;
-  ceres::Solve(ceres_options, &problem, &ceres_summary);
+  ceres::Solve(ceres_options, problem_.get(), &ceres_summary);
   VLOG(1) << ceres_summary.FullReport();
 
   if (ceres_summary.IsSolutionUsable()) {  // Else Ceres' costs are not those of its start and end.
@@ -100,6 +102,13 @@ void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   summary->seconds_evaluation = ceres_summary.residual_evaluation_time_in_seconds +
                                 ceres_summary.jacobian_evaluation_time_in_seconds;
   summary->seconds_linear_solver = ceres_summary.linear_solver_time_in_seconds;
+}
+
+void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
+                    SolverSummary* summary, FrameCostFunctions::Layout layout) {
+  const Stopwatch clock;
+  CeresFrameProblem(energy, options.curvature == CurvatureModel::kSecant, layout, k)
+      .Solve(options, clock, summary);
 }
 
 }  // namespace internal

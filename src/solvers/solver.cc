@@ -1,6 +1,7 @@
 #include "finecap/solvers/solver.h"
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "finecap/util/error.h"
@@ -28,35 +29,55 @@ void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double
 }
 
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {
-  options.Check();
-  Require(k->size() == energy->num_parameters(), "solver", "k has the wrong size");
-  const double k_max = energy->options().k_max;
+  return FrameSolver(energy, options).Solve(k);
+}
+
+FrameSolver::FrameSolver(FrameEnergy* energy, const SolverOptions& options)
+    : energy_(energy), options_(options) {
+  options_.Check();
+}
+
+FrameSolver::~FrameSolver() = default;
+
+void FrameSolver::SolveWithCeres(Eigen::VectorXd* k, SolverSummary* summary) {
+  const internal::Stopwatch clock;
+  if (ceres_ == nullptr || ceres_->k() != k) {
+    ceres_ = std::make_unique<internal::CeresFrameProblem>(
+        energy_, options_.curvature == CurvatureModel::kSecant,
+        FrameCostFunctions::Layout::kPerGaussian, k);
+  }
+  ceres_->Solve(options_, clock, summary);
+}
+
+SolverSummary FrameSolver::Solve(Eigen::VectorXd* k) {
+  Require(k->size() == energy_->num_parameters(), "solver", "k has the wrong size");
+  const double k_max = energy_->options().k_max;
   *k = k->cwiseMax(-k_max).cwiseMin(k_max);
   SolverSummary summary;
-  summary.solver = EnumToString(options.type);
-  if (options.type == SolverType::kCeres && energy->similarity().IsLeastSquares() &&
+  summary.solver = EnumToString(options_.type);
+  if (options_.type == SolverType::kCeres && energy_->similarity().IsLeastSquares() &&
       k->size() > 0) {
     // Ceres' own start and final costs are the least-squares cost, and so give E.
     const Eigen::VectorXd start = *k;
     summary.ls_cost_start = summary.ls_cost_end = std::nan("");
-    internal::SolveWithCeres(energy, options, k, &summary);
+    SolveWithCeres(k, &summary);
     if (std::isnan(summary.ls_cost_start)) {
-      summary.ls_cost_start = LeastSquaresCost(energy, start);
-      summary.ls_cost_end = LeastSquaresCost(energy, *k);
+      summary.ls_cost_start = LeastSquaresCost(energy_, start);
+      summary.ls_cost_end = LeastSquaresCost(energy_, *k);
     }
     summary.energy_start = -summary.ls_cost_start;
     summary.energy_end = -summary.ls_cost_end;
     return summary;
   }
-  EvaluateEnergyAndCost(energy, *k, &summary.energy_start, &summary.ls_cost_start);
-  if (options.type == SolverType::kCeres) {
-    internal::SolveWithCeres(energy, options, k, &summary);
-  } else if (options.type == SolverType::kGradientAscent) {
-    internal::SolveWithGradientAscent(*energy, options, k, &summary);
+  EvaluateEnergyAndCost(energy_, *k, &summary.energy_start, &summary.ls_cost_start);
+  if (options_.type == SolverType::kCeres) {
+    SolveWithCeres(k, &summary);
+  } else if (options_.type == SolverType::kGradientAscent) {
+    internal::SolveWithGradientAscent(*energy_, options_, k, &summary);
   } else {
-    internal::SolveWithLbfgs(*energy, options, k, &summary);
+    internal::SolveWithLbfgs(*energy_, options_, k, &summary);
   }
-  EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
+  EvaluateEnergyAndCost(energy_, *k, &summary.energy_end, &summary.ls_cost_end);
   return summary;
 }
 

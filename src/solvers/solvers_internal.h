@@ -4,6 +4,7 @@
 #define FINECAP_SRC_SOLVERS_SOLVERS_INTERNAL_H_
 
 #include <chrono>
+#include <memory>
 
 #include <ceres/iteration_callback.h>
 
@@ -48,6 +49,32 @@ class TraceRecorder : public ceres::IterationCallback {
  private:
   const Stopwatch& clock_;
   SolverSummary* summary_;
+};
+
+// The least-squares form of a frame's energy as a Ceres problem, built once and solved as often
+// as asked over the same k: the cost functions, residual blocks and parameter blocks (on
+// synth_skirt ~10-15 ms to build and free, on the solving thread alone) then serve every pass of
+// the frame. Between two solves the energy's values may change (a pass's patch shape), not its
+// structure (its residual blocks, regulariser, prior and k_max): each solve forgets the point
+// prepared last and the secant histories, so that it takes the steps a problem built afresh
+// would.
+class CeresFrameProblem {
+ public:
+  // The problem over the parameter blocks &(*k)[s]; `secant`: CurvatureModel::kSecant.
+  CeresFrameProblem(FrameEnergy* energy, bool secant, FrameCostFunctions::Layout layout,
+                    Eigen::VectorXd* k);
+  // Solves from *k, in place. `clock` started with the solve (before the problem was built, if it
+  // was built for it); the summary's times and trace are taken against it.
+  void Solve(const SolverOptions& options, const Stopwatch& clock, SolverSummary* summary);
+  // The vector whose entries are the parameter blocks.
+  const Eigen::VectorXd* k() const { return k_; }
+
+ private:
+  Eigen::VectorXd* k_;
+  double seconds_shared_ = 0.0;
+  SharedEvaluationCallback shared_;
+  FrameCostFunctions cost_functions_;  // Outlive the problem, which does not own them.
+  std::unique_ptr<ceres::Problem> problem_;
 };
 
 }  // namespace internal

@@ -16,6 +16,7 @@
 #ifndef FINECAP_SOLVER_H_
 #define FINECAP_SOLVER_H_
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,38 @@ struct SolverSummary {
 
 // Maximises the energy over k (one entry per surface Gaussian, metres), starting from *k.
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k);
+
+namespace internal {
+class CeresFrameProblem;
+}  // namespace internal
+
+// Solve, for one frame's energy solved more than once: the consensus similarity's passes, each
+// after the energy's patch shape has changed. Ceres' problem (its cost functions, residual and
+// parameter blocks) is built at the first solve and kept for the next ones over the same k, where
+// Solve would build and free it every time (~10-15 ms on synth_skirt, on the solving thread
+// alone); each solve takes the same steps as Solve. The other solvers keep nothing.
+//
+// Between solves the energy's values may change, not its structure: the same residual blocks,
+// regulariser, prior and k_max. `energy` must outlive the solver.
+class FrameSolver {
+ public:
+  FrameSolver(FrameEnergy* energy, const SolverOptions& options);
+  ~FrameSolver();
+  FrameSolver(const FrameSolver&) = delete;
+  FrameSolver& operator=(const FrameSolver&) = delete;
+
+  // As Solve(energy, options, k). A Ceres problem built over another vector than `k` is built
+  // again over `k`.
+  SolverSummary Solve(Eigen::VectorXd* k);
+
+ private:
+  // The Ceres solve of *k into *summary, building the problem first where needed.
+  void SolveWithCeres(Eigen::VectorXd* k, SolverSummary* summary);
+
+  FrameEnergy* energy_;
+  SolverOptions options_;
+  std::unique_ptr<internal::CeresFrameProblem> ceres_;
+};
 
 // 1/2 sum of squared residuals of the least-squares form at k (similarity and regulariser).
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k);
