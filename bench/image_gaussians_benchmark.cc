@@ -1,7 +1,9 @@
 // Speed of the image model: building the image Gaussians of a frame (8 cameras, 1004 x 1004) and
 // querying them once per surface Gaussian, as the energy does.
+#include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -138,6 +140,36 @@ void BM_FindReaching(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * points.size());
 }
 BENCHMARK(BM_FindReaching)->Unit(benchmark::kMillisecond);
+
+// The queries of BuildCameraPairs: the same surface Gaussians, each moving along its normal over a
+// segment of up to 16 px in any direction (the projection of +-k_max), among the 1 px leaves of
+// finecap refine's default.
+void BM_FindReachingSegment(benchmark::State& state) {
+  const ImageGaussians gaussians =
+      BuildImageGaussians(FrameImages()[0], cv::Mat(), LeafSizeOptions(1), "cam0");
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> coordinate(0.25 * kImageSide, 0.75 * kImageSide);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), length(0.0, 16.0);
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> segments(80000);
+  for (auto& [start, end] : segments) {
+    start = Eigen::Vector2d(coordinate(rng), coordinate(rng));
+    const double a = angle(rng);
+    end = start + length(rng) * Eigen::Vector2d(std::cos(a), std::sin(a));
+  }
+  std::vector<int> found;
+  size_t total_found = 0;
+  for (auto _ : state) {
+    total_found = 0;
+    for (const auto& [start, end] : segments) {
+      gaussians.FindReachingSegment(start, end, 2.8, 3.0, &found);
+      total_found += found.size();
+    }
+    benchmark::DoNotOptimize(total_found);
+  }
+  state.counters["found_per_query"] = double(total_found) / segments.size();
+  state.SetItemsProcessed(state.iterations() * segments.size());
+}
+BENCHMARK(BM_FindReachingSegment)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace finecap
