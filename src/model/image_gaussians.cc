@@ -360,6 +360,72 @@ void CountingSort(const std::vector<int>& keys, int num_keys, std::vector<int>* 
   for (size_t i = 0; i < keys.size(); ++i) (*order)[next[keys[i]]++] = static_cast<int>(i);
 }
 
+// A query of CollectNear: the segment [start, end] (a point when they are equal) and the
+// threshold base + sigma_factor * sigma_i^2 on the squared distance.
+struct NearQuery {
+  NearQuery(const Eigen::Vector2d& start, const Eigen::Vector2d& end, double base,
+            double sigma_factor)
+      : start(start),
+        direction(end - start),
+        length_squared(direction.squaredNorm()),
+        is_point(!(length_squared > 0.0)),
+        base(base),
+        sigma_factor(sigma_factor) {}
+
+  Eigen::Vector2d start;
+  Eigen::Vector2d direction;
+  double length_squared;
+  bool is_point;
+  double base;
+  double sigma_factor;
+};
+
+// Whether Gaussians i and j (possibly the same) are within the query's reach, as a pair of lanes:
+// two at a time in SIMD, and the clamp to the segment as max and min, with no branch on which end
+// is nearest. The arithmetic is in double from the stored floats, operation for operation that of
+// the nearest point of the segment, so that the same Gaussians pass at the boundary; Eigen's max
+// and min take std::max and std::min's operand on ties and NaN, as std::clamp does. Inline: GCC
+// would otherwise call it, reloading the query for every pair.
+template <bool kSegment>
+inline Eigen::Array<bool, 2, 1> WithinReach(const ImageGaussian* gaussians, int i, int j,
+                                            const NearQuery& query) {
+  Eigen::Array2d offset_x(double(gaussians[i].x), double(gaussians[j].x));
+  Eigen::Array2d offset_y(double(gaussians[i].y), double(gaussians[j].y));
+  offset_x -= query.start.x();
+  offset_y -= query.start.y();
+  if constexpr (kSegment) {
+    const Eigen::Array2d along =
+        (offset_x * query.direction.x() + offset_y * query.direction.y()) / query.length_squared;
+    const Eigen::Array2d t = along.max(0.0).min(1.0);
+    offset_x -= t * query.direction.x();
+    offset_y -= t * query.direction.y();
+  }
+  const Eigen::Array2d sigma(double(gaussians[i].sigma), double(gaussians[j].sigma));
+  return offset_x * offset_x + offset_y * offset_y <=
+         query.base + query.sigma_factor * sigma * sigma;
+}
+
+// Writes the indices in [begin, stop) of the Gaussians within the query's reach to `out`, in
+// order, and returns how many. Every index is written and kept by advancing past it: no branch
+// on the test, whose outcome is close to a coin flip.
+template <bool kSegment>
+int ScanRun(const ImageGaussian* gaussians, int begin, int stop, const NearQuery& query, int* out) {
+  int kept = 0;
+  int i = begin;
+  for (; i + 1 < stop; i += 2) {
+    const Eigen::Array<bool, 2, 1> within = WithinReach<kSegment>(gaussians, i, i + 1, query);
+    out[kept] = i;
+    kept += within[0];
+    out[kept] = i + 1;
+    kept += within[1];
+  }
+  if (i < stop) {
+    out[kept] = i;
+    kept += WithinReach<kSegment>(gaussians, i, i, query)[0];
+  }
+  return kept;
+}
+
 }  // namespace
 
 void ImageGaussianOptions::Check() const {
@@ -463,8 +529,7 @@ std::pair<int, int> ImageGaussians::SizeClass::CellRange(double low, double high
 void ImageGaussians::CollectNear(const Eigen::Vector2d& start, const Eigen::Vector2d& end,
                                  double base, double sigma_factor,
                                  std::vector<int>* indices) const {
-  const Eigen::Vector2d direction = end - start;
-  const double length_squared = direction.squaredNorm();
+  const NearQuery query(start, end, base, sigma_factor);
   const Eigen::Vector2d low = start.cwiseMin(end), high = start.cwiseMax(end);
   for (const SizeClass& size_class : classes_) {
     const double max_sigma = size_class.max_sigma;
@@ -475,21 +540,24 @@ void ImageGaussians::CollectNear(const Eigen::Vector2d& start, const Eigen::Vect
                                                             size_class.origin_x, size_class.cols);
     const auto [row_first, row_last] = size_class.CellRange(low.y() - radius, high.y() + radius,
                                                             size_class.origin_y, size_class.rows);
+    // Room for every candidate, for ScanRun writes each one before it knows whether to keep it.
+    int candidates = 0;
+    for (int row = row_first; row <= row_last; ++row) {
+      candidates += size_class.cell_begin[row * size_class.cols + col_last + 1] -
+                    size_class.cell_begin[row * size_class.cols + col_first];
+    }
+    if (candidates == 0) continue;
+    const size_t kept_before = indices->size();
+    indices->resize(kept_before + candidates);
+    int* out = indices->data() + kept_before;
     for (int row = row_first; row <= row_last; ++row) {
       // The cells of one grid row are contiguous in gaussians_.
       const int begin = size_class.cell_begin[row * size_class.cols + col_first];
       const int stop = size_class.cell_begin[row * size_class.cols + col_last + 1];
-      for (int i = begin; i < stop; ++i) {
-        const ImageGaussian& g = gaussians_[i];
-        Eigen::Vector2d offset(g.x - start.x(), g.y - start.y());
-        if (length_squared > 0.0) {
-          // From the nearest point of the segment.
-          offset -= std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) * direction;
-        }
-        const double sigma = g.sigma;
-        if (offset.squaredNorm() <= base + sigma_factor * sigma * sigma) indices->push_back(i);
-      }
+      out += query.is_point ? ScanRun<false>(gaussians_.data(), begin, stop, query, out)
+                            : ScanRun<true>(gaussians_.data(), begin, stop, query, out);
     }
+    indices->resize(out - indices->data());
   }
 }
 
