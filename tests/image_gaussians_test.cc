@@ -138,6 +138,56 @@ void ExpectQueriesMatchBruteForce(const ImageGaussians& gaussians, unsigned seed
   }
 }
 
+// The Gaussians within reach of the segment [start, end], by a scan of every one.
+std::vector<int> ReachingSegmentByScan(const ImageGaussians& gaussians,
+                                       const Eigen::Vector2d& start, const Eigen::Vector2d& end,
+                                       double sigma, double cutoff) {
+  return BruteForce(gaussians, [&](const ImageGaussian& g) {
+    const Eigen::Vector2d direction = end - start;
+    const Eigen::Vector2d offset = Eigen::Vector2d(g.x, g.y) - start;
+    const double length_squared = direction.squaredNorm();
+    const double t =
+        length_squared > 0.0 ? std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) : 0.0;
+    const double sigma_i = g.sigma, cutoff_squared = cutoff * cutoff;
+    return (offset - t * direction).squaredNorm() <=
+           cutoff_squared * sigma * sigma + cutoff_squared * sigma_i * sigma_i;
+  });
+}
+
+// Segments that a bound of the scan tighter than the exact test would cut: long diagonal ones
+// with small reach, ones crossing the grid's edge or lying far outside it, points, and ones
+// ending exactly on a Gaussian's mean. The result must be the scan's, in the scan's (ascending)
+// order: sums over it downstream are added in that order.
+void ExpectSegmentQueriesMatchScanInOrder(const ImageGaussians& gaussians, unsigned seed) {
+  std::mt19937 rng(seed);
+  const double width = gaussians.width(), height = gaussians.height();
+  std::uniform_real_distribution<double> px(-0.5 * width, 1.5 * width);
+  std::uniform_real_distribution<double> py(-0.5 * height, 1.5 * height);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), length(0.0, 2.0 * width);
+  std::uniform_real_distribution<double> sigma(0.05, 3.0), cutoff(0.2, 3.0);
+  std::uniform_int_distribution<int> pick(0, gaussians.size() - 1);
+  std::vector<int> found;
+  size_t total_found = 0;
+  for (int q = 0; q < 400; ++q) {
+    Eigen::Vector2d start(px(rng), py(rng));
+    const double a = q % 7 == 0 ? M_PI / 4 : q % 7 == 1 ? 0.0 : q % 7 == 2 ? M_PI / 2 : angle(rng);
+    Eigen::Vector2d end = start + length(rng) * Eigen::Vector2d(std::cos(a), std::sin(a));
+    if (q % 11 == 0) end = start;
+    if (q % 13 == 0) {
+      const ImageGaussian& g = gaussians[pick(rng)];
+      end = Eigen::Vector2d(g.x, g.y);
+    }
+    if (q % 17 == 0) start *= 1e6;  // Far outside.
+    const double s = sigma(rng), c = cutoff(rng);
+    gaussians.FindReachingSegment(start, end, s, c, &found);
+    EXPECT_EQ(found, ReachingSegmentByScan(gaussians, start, end, s, c))
+        << "sigma " << s << " cutoff " << c << " from " << start.transpose() << " to "
+        << end.transpose();
+    total_found += found.size();
+  }
+  EXPECT_GT(total_found, 400u) << "the queries should reach Gaussians";
+}
+
 template <typename Call>
 void ExpectErrorMentions(Call call, const std::vector<std::string>& parts) {
   try {
@@ -323,6 +373,7 @@ TEST(ImageGaussiansTest, QueriesMatchBruteForceOnQuadTreeLeaves) {
                                                        SmallTreeOptions(2, 6, 0.03), "leaves.png");
   ASSERT_GT(gaussians.size(), 500);
   ExpectQueriesMatchBruteForce(gaussians, 17);
+  ExpectSegmentQueriesMatchScanInOrder(gaussians, 18);
 }
 
 TEST(ImageGaussiansTest, QueriesMatchBruteForceOnArbitraryGaussians) {
@@ -339,6 +390,7 @@ TEST(ImageGaussiansTest, QueriesMatchBruteForceOnArbitraryGaussians) {
   const ImageGaussians gaussians(100, 100, ColorSpace::kHsv, list, "hand-made");
   EXPECT_EQ(gaussians.size(), 700);
   ExpectQueriesMatchBruteForce(gaussians, 23);
+  ExpectSegmentQueriesMatchScanInOrder(gaussians, 24);
 }
 
 TEST(ImageGaussiansTest, RejectsInvalidGaussians) {
