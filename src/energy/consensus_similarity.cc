@@ -566,7 +566,8 @@ void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<doubl
   costs->resize(num_blocks);
   const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
   if (uniform) {
-    UniformCosts<1>(k.data(), costs->data(), num_blocks);
+    std::vector<double> lane_colors;
+    UniformCosts<1>(k.data(), costs->data(), num_blocks, &lane_colors);
     return;
   }
 #pragma omp parallel for schedule(dynamic, 64)
@@ -586,23 +587,26 @@ void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
   costs->resize(num_blocks, displacements.size());
   // Eight displacements at a time; the rest one at a time, so that no lane is computed in vain.
   constexpr int kLanes = 8;
+  // The row colours live for this call only: at 24 bytes per row and lane, eight lanes take
+  // more than half the tables' memory again.
+  std::vector<double> lane_colors;
   int j = 0;
   for (; j + kLanes <= displacements.size(); j += kLanes) {
-    UniformCosts<kLanes>(&displacements[j], &(*costs)(0, j), num_blocks);
+    UniformCosts<kLanes>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
   }
   for (; j < displacements.size(); ++j) {
-    UniformCosts<1>(&displacements[j], &(*costs)(0, j), num_blocks);
+    UniformCosts<1>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
   }
 }
 
 template <int kLanes>
 void ConsensusSimilarity::UniformCosts(const double* displacements, double* costs,
-                                       long column_stride) {
+                                       long column_stride, std::vector<double>* lane_colors) const {
   // Every row at the same k: one set of Hermite weights for all, per lane.
   HermiteWeights weights[kLanes];
   for (int lane = 0; lane < kLanes; ++lane) weights[lane] = HermiteAt(displacements[lane]);
   const int num_rows = first_row_.back(), num_blocks = static_cast<int>(blocks_.size());
-  lane_colors_.resize(3L * kLanes * num_rows);
+  lane_colors->resize(3L * kLanes * num_rows);
   // One parallel region for both loops: on a busy machine each region's start and barrier can
   // wait a time slice for a thread.
 #pragma omp parallel
@@ -610,7 +614,7 @@ void ConsensusSimilarity::UniformCosts(const double* displacements, double* cost
 #pragma omp for schedule(static)
     for (int row = 0; row < num_rows; ++row) {
       const TableNode* row_nodes = &table_[long(row) * num_nodes_];
-      double* colors = &lane_colors_[3L * kLanes * row];
+      double* colors = &(*lane_colors)[3L * kLanes * row];
       for (int lane = 0; lane < kLanes; ++lane) {
         double color[3];
         Blend(weights[lane].value, row_nodes + weights[lane].node, color);
@@ -622,7 +626,7 @@ void ConsensusSimilarity::UniformCosts(const double* displacements, double* cost
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
       double block_costs[kLanes];
-      UniformCostsOfBlock<kLanes>(b, lane_colors_.data(), scratch.data(), block_costs);
+      UniformCostsOfBlock<kLanes>(b, lane_colors->data(), scratch.data(), block_costs);
       for (int lane = 0; lane < kLanes; ++lane) costs[b + lane * column_stride] = block_costs[lane];
     }
   }

@@ -166,9 +166,11 @@ class ConsensusSimilarity : public SimilarityTerm {
   // applied to the sums instead of to every residual: what the solvers and the sweep need.
   BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
   // Every block's cost, as SummaryAt's squared_norm, with all k_s at each of
-  // displacements[0 .. kLanes) and flat patches: costs[b + lane * column_stride].
+  // displacements[0 .. kLanes) and flat patches: costs[b + lane * column_stride]. Every table
+  // row's colour at each displacement goes to `lane_colors` (row, channel, lane).
   template <int kLanes>
-  void UniformCosts(const double* displacements, double* costs, long column_stride);
+  void UniformCosts(const double* displacements, double* costs, long column_stride,
+                    std::vector<double>* lane_colors) const;
   // Block b's costs at the kLanes displacements of `lane_colors` (every table row's colour at
   // each: row, channel, lane), lane by lane with SummaryAt's operations in its order. `scratch`
   // holds 3 kLanes doubles per row of the block.
@@ -202,8 +204,7 @@ class ConsensusSimilarity : public SimilarityTerm {
   std::vector<int> first_row_;
   std::vector<TableNode> table_;
   Eigen::VectorXd shape_;
-  std::vector<double> lane_colors_;  // UniformCosts' colours of every table row.
-  int max_block_rows_ = 0;           // The most table rows a block reads.
+  int max_block_rows_ = 0;  // The most table rows a block reads.
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_;
