@@ -142,6 +142,101 @@ TEST_P(ScalarAndResidualsTest, BlockCostsAreEachBlocksSumOfSquares) {
 INSTANTIATE_TEST_SUITE_P(SumOfSquares, ScalarAndResidualsTest,
                          ::testing::Values("surface_color", "consensus"));
 
+// The plane sweep's costs for every similarity: UniformBlockCosts at each displacement is
+// BlockCosts there, to the bit (for consensus, several displacements at a time against one).
+TEST(SimilarityTermTest, UniformBlockCostsAreBlockCostsAtEachDisplacement) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  for (const std::string similarity : {"paper", "surface_color", "consensus"}) {
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                       Options(similarity, "printed"));
+    SimilarityTerm& term = energy.similarity();
+    const int n = energy.num_parameters();
+    const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(9, -0.01, 0.01);
+    Eigen::MatrixXd costs;
+    term.UniformBlockCosts(n, displacements, &costs);
+    ASSERT_EQ(costs.rows(), static_cast<Eigen::Index>(term.residual_blocks().size()));
+    ASSERT_EQ(costs.cols(), displacements.size());
+    for (int j = 0; j < displacements.size(); ++j) {
+      std::vector<double> block_costs;
+      term.BlockCosts(Eigen::VectorXd::Constant(n, displacements[j]), &block_costs);
+      for (int b = 0; b < costs.rows(); ++b) {
+        EXPECT_EQ(costs(b, j), block_costs[b]) << similarity << " block " << b << " sample " << j;
+      }
+    }
+    EXPECT_GT(costs.sum(), 0.0) << similarity;
+  }
+}
+
+struct UniformCostsCase {
+  bool gain_per_channel;
+  double contrast_floor;
+  double robust_fraction;
+};
+
+std::ostream& operator<<(std::ostream& os, const UniformCostsCase& variant) {
+  return os << "gain_per_channel " << variant.gain_per_channel << ", contrast_floor "
+            << variant.contrast_floor << ", robust_fraction " << variant.robust_fraction;
+}
+
+class ConsensusUniformCostsTest : public ::testing::TestWithParam<UniformCostsCase> {};
+
+// The consensus similarity reduces each block to its cost at the sweep's uniform displacements
+// without writing its residuals, several displacements at a time. Each cost must be the one the
+// residual path gives: bit for bit that of SummaryAt (which BlockCosts takes when k is not
+// uniform; a block depends on its centre's k alone), and to rounding the sum of squares of the
+// residuals PrepareResiduals writes (the robust loss applied to each). With a patch shape set,
+// the costs come from the residual path itself.
+TEST_P(ConsensusUniformCostsTest, CostsAreThoseOfTheResidualPath) {
+  const UniformCostsCase variant = GetParam();
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  EnergyOptions options = Options("consensus", "printed");
+  options.consensus.gain_per_channel = variant.gain_per_channel;
+  options.consensus.contrast_floor = variant.contrast_floor;
+  options.consensus.robust_fraction = variant.robust_fraction;
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+  auto& consensus = dynamic_cast<ConsensusSimilarity&>(energy.similarity());
+  const auto& blocks = consensus.residual_blocks();
+  ASSERT_GT(blocks.size(), 10u);
+  const int n = energy.num_parameters();
+  // Eleven: a batch of eight and three alone; on the tables' nodes, between them and beyond.
+  const Eigen::VectorXd displacements =
+      Eigen::VectorXd::LinSpaced(11, -1.2 * options.k_max, 1.1 * options.k_max);
+  for (const bool shaped : {false, true}) {
+    consensus.SetPatchShape(shaped ? RandomK(n, 0.003, 5) : Eigen::VectorXd::Zero(n));
+    Eigen::MatrixXd costs;
+    consensus.UniformBlockCosts(n, displacements, &costs);
+    ASSERT_EQ(costs.rows(), static_cast<Eigen::Index>(blocks.size()));
+    ASSERT_EQ(costs.cols(), displacements.size());
+    double total = 0.0;
+    for (int j = 0; j < displacements.size(); ++j) {
+      Eigen::VectorXd k = Eigen::VectorXd::Constant(n, displacements[j]);
+      const int moved = blocks[0].parameters[0];
+      k[moved] += 1e-4;
+      std::vector<double> summary_costs;
+      consensus.BlockCosts(k, &summary_costs);
+      consensus.PrepareResiduals(Eigen::VectorXd::Constant(n, displacements[j]), false);
+      for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+        if (blocks[b].parameters[0] != moved) {
+          EXPECT_EQ(costs(b, j), summary_costs[b]) << "block " << b << " sample " << j;
+        }
+        std::vector<double> residuals(blocks[b].num_residuals);
+        consensus.BlockResiduals(b, residuals.data(), nullptr);
+        double sum = 0.0;
+        for (double r : residuals) sum += r * r;
+        EXPECT_NEAR(costs(b, j), sum, 1e-12 * (1.0 + sum)) << "block " << b << " sample " << j;
+        total += sum;
+      }
+    }
+    EXPECT_GT(total, 0.0) << "shaped " << shaped;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    NormalisationsAndLosses, ConsensusUniformCostsTest,
+    ::testing::Values(UniformCostsCase{true, 0.005, 0.5}, UniformCostsCase{false, 0.005, 0.5},
+                      UniformCostsCase{true, 1e-6, 0.0}, UniformCostsCase{false, 1e-6, 0.0},
+                      UniformCostsCase{true, 0.5, 0.5}, UniformCostsCase{false, 0.5, 0.0}));
+
 // A camera's gain and offset (per channel, as exposure and white balance) change each block's
 // weight but not the direction of its residual vector: the disagreement the solver sees is the
 // same up to a factor per block, so its optimum does not move.

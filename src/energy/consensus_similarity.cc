@@ -83,6 +83,68 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
   }
 }
 
+// The values of one quantity at kLanes displacements side by side (the plane sweep's samples),
+// so that the loops over them run over several at a time. Each lane gets the same operations in
+// the same order as a single displacement would, so the same bits: Eigen's packets round every
+// operation as the scalar one does, and the build contracts no multiply-add (SSE2).
+template <int kLanes>
+using Lanes = Eigen::Array<double, kLanes, 1>;
+
+template <int kLanes>
+Eigen::Map<Lanes<kLanes>> LanesAt(double* values) {
+  return Eigen::Map<Lanes<kLanes>>(values);
+}
+
+template <int kLanes>
+Eigen::Map<const Lanes<kLanes>> LanesAt(const double* values) {
+  return Eigen::Map<const Lanes<kLanes>>(values);
+}
+
+// Normalise without derivatives, of one patch in one camera at kLanes displacements at once,
+// reading its members' colours from `lane_colors` (table row `rows[m]` of member m, its channel
+// c at lane l in lane_colors[(3 rows[m] + c) kLanes + l]) and writing z in the same layout, member
+// after member, to `z`.
+template <int kLanes>
+void NormaliseLanes(int n, double floor, bool pooled, const int* rows, const double* lane_colors,
+                    double* z) {
+  Lanes<kLanes> mean[3], variance[3];
+  for (int channel = 0; channel < 3; ++channel) {
+    mean[channel].setZero();
+    variance[channel].setZero();
+  }
+  for (int m = 0; m < n; ++m) {
+    const double* colors = &lane_colors[3L * kLanes * rows[m]];
+    for (int channel = 0; channel < 3; ++channel) {
+      const auto color = LanesAt<kLanes>(colors + kLanes * channel);
+      LanesAt<kLanes>(z + kLanes * (3 * m + channel)) = color;
+      mean[channel] += color;
+    }
+  }
+  for (auto& value : mean) value /= n;
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      const Lanes<kLanes> difference =
+          LanesAt<kLanes>(z + kLanes * (3 * m + channel)) - mean[channel];
+      variance[channel] += difference * difference;
+    }
+  }
+  for (auto& value : variance) value /= n;
+  if (pooled) {
+    const Lanes<kLanes> pooled_variance = (variance[0] + variance[1] + variance[2]) / 3.0;
+    for (auto& value : variance) value = pooled_variance;
+  }
+  Lanes<kLanes> inverse_deviation[3];
+  for (int channel = 0; channel < 3; ++channel) {
+    inverse_deviation[channel] = 1.0 / (variance[channel] + floor * floor).sqrt();
+  }
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      auto value = LanesAt<kLanes>(z + kLanes * (3 * m + channel));
+      value = (value - mean[channel]) * inverse_deviation[channel];
+    }
+  }
+}
+
 // Cauchy's loss rho(s) = c2 log(1 + s / c2) of a block's sum of squares s = |r|^2 as a scaling of
 // its residuals r' = alpha r, alpha = sqrt(rho(s) / s), so that |r'|^2 = rho(s): a block that
 // disagrees far more than c2 stops pulling its Gaussian harder, and the regulariser carries its
@@ -192,6 +254,10 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
   }
   patch_begin_.push_back(static_cast<int>(members_.size()));
   camera_begin_.push_back(static_cast<int>(cameras_.size()));
+  for (size_t b = 0; b < blocks_.size(); ++b) {
+    max_block_rows_ =
+        std::max(max_block_rows_, static_cast<int>(row_begin_[b + 1] - row_begin_[b]));
+  }
 
   residual_begin_.assign(1, 0);
   for (const ResidualBlock& block : blocks_) {
@@ -361,17 +427,9 @@ Eigen::Vector3d ConsensusSimilarity::Interpolate(int c, int row, double k,
   return color;
 }
 
-void ConsensusSimilarity::PatchColors(int b, double k, double* colors, double* derivatives,
-                                      const Eigen::Vector3d* row_colors) const {
+void ConsensusSimilarity::PatchColors(int b, double k, double* colors, double* derivatives) const {
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   const int* rows = &rows_[row_begin_[b]];
-  if (row_colors != nullptr) {
-    for (int i = 0; i < num_cameras * n; ++i) {
-      const Eigen::Vector3d& color = row_colors[rows[i]];
-      colors[3 * i] = color[0], colors[3 * i + 1] = color[1], colors[3 * i + 2] = color[2];
-    }
-    return;
-  }
   // A member's k, and so its node interval and Hermite weights, is the same in every camera:
   // each camera only reads its two nodes.
   thread_local std::vector<HermiteWeights> weights;
@@ -408,12 +466,12 @@ Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
   return (variance / num_cameras).cwiseSqrt();
 }
 
-void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals, double* jacobian,
-                                         const Eigen::Vector3d* row_colors) const {
+void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals,
+                                         double* jacobian) const {
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   // The colours become the residuals in place: normalised per camera, then each against the
   // cameras' mean.
-  PatchColors(b, k, residuals, jacobian, row_colors);
+  PatchColors(b, k, residuals, jacobian);
   const int stride = 3 * n;  // From one camera's patch to the next.
   for (int a = 0; a < num_cameras; ++a) {
     Normalise(n, options_.contrast_floor, !options_.gain_per_channel, residuals + stride * a,
@@ -452,13 +510,13 @@ void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* ja
   Robustify(LossScale(b), blocks_[b].num_residuals, residuals, jacobian);
 }
 
-SimilarityTerm::BlockSummary ConsensusSimilarity::SummaryAt(
-    int b, double k, bool with_derivatives, const Eigen::Vector3d* row_colors) const {
+SimilarityTerm::BlockSummary ConsensusSimilarity::SummaryAt(int b, double k,
+                                                            bool with_derivatives) const {
   thread_local std::vector<double> residuals, jacobian;
   const int num_residuals = blocks_[b].num_residuals;
   residuals.resize(num_residuals);
   jacobian.resize(with_derivatives ? num_residuals : 0);
-  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr, row_colors);
+  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr);
   BlockSummary plain;
   if (with_derivatives) {
     plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
@@ -507,29 +565,105 @@ void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<doubl
   const int num_blocks = static_cast<int>(blocks_.size());
   costs->resize(num_blocks);
   const bool uniform = k.size() > 0 && (k.array() == k[0]).all() && shape_.isZero(0.0);
-  if (!uniform) {
-#pragma omp parallel for schedule(dynamic, 64)
-    for (int b = 0; b < num_blocks; ++b) {
-      (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
-    }
+  if (uniform) {
+    std::vector<double> lane_colors;
+    UniformCosts<1>(k.data(), costs->data(), num_blocks, &lane_colors);
     return;
   }
-  // Every row at the same k: one set of Hermite weights for all.
-  const HermiteWeights weights = HermiteAt(k[0]);
-  const int num_rows = first_row_.back();
-  row_colors_.resize(num_rows);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
+  }
+}
+
+void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
+                                            const Eigen::VectorXd& displacements,
+                                            Eigen::MatrixXd* costs) {
+  if (!shape_.isZero(0.0)) {
+    SimilarityTerm::UniformBlockCosts(num_parameters, displacements, costs);
+    return;
+  }
+  const long num_blocks = static_cast<long>(blocks_.size());
+  costs->resize(num_blocks, displacements.size());
+  // Eight displacements at a time; the rest one at a time, so that no lane is computed in vain.
+  constexpr int kLanes = 8;
+  // The row colours live for this call only: at 24 bytes per row and lane, eight lanes take
+  // more than half the tables' memory again.
+  std::vector<double> lane_colors;
+  int j = 0;
+  for (; j + kLanes <= displacements.size(); j += kLanes) {
+    UniformCosts<kLanes>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
+  }
+  for (; j < displacements.size(); ++j) {
+    UniformCosts<1>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
+  }
+}
+
+template <int kLanes>
+void ConsensusSimilarity::UniformCosts(const double* displacements, double* costs,
+                                       long column_stride, std::vector<double>* lane_colors) const {
+  // Every row at the same k: one set of Hermite weights for all, per lane.
+  HermiteWeights weights[kLanes];
+  for (int lane = 0; lane < kLanes; ++lane) weights[lane] = HermiteAt(displacements[lane]);
+  const int num_rows = first_row_.back(), num_blocks = static_cast<int>(blocks_.size());
+  lane_colors->resize(3L * kLanes * num_rows);
   // One parallel region for both loops: on a busy machine each region's start and barrier can
-  // wait a time slice for a thread, and the sweep calls this for every sample.
+  // wait a time slice for a thread.
 #pragma omp parallel
   {
 #pragma omp for schedule(static)
     for (int row = 0; row < num_rows; ++row) {
-      Blend(weights.value, &table_[long(row) * num_nodes_ + weights.node], row_colors_[row].data());
+      const TableNode* row_nodes = &table_[long(row) * num_nodes_];
+      double* colors = &(*lane_colors)[3L * kLanes * row];
+      for (int lane = 0; lane < kLanes; ++lane) {
+        double color[3];
+        Blend(weights[lane].value, row_nodes + weights[lane].node, color);
+        for (int channel = 0; channel < 3; ++channel)
+          colors[channel * kLanes + lane] = color[channel];
+      }
     }
+    std::vector<double> scratch(3L * kLanes * max_block_rows_);
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
-      (*costs)[b] = SummaryAt(b, k[0], false, row_colors_.data()).squared_norm;
+      double block_costs[kLanes];
+      UniformCostsOfBlock<kLanes>(b, lane_colors->data(), scratch.data(), block_costs);
+      for (int lane = 0; lane < kLanes; ++lane) costs[b + lane * column_stride] = block_costs[lane];
     }
+  }
+}
+
+template <int kLanes>
+void ConsensusSimilarity::UniformCostsOfBlock(int b, const double* lane_colors, double* scratch,
+                                              double costs[kLanes]) const {
+  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  const int* rows = &rows_[row_begin_[b]];
+  const int stride = 3 * kLanes * n;  // From one camera's patch to the next.
+  for (int a = 0; a < num_cameras; ++a) {
+    NormaliseLanes<kLanes>(n, options_.contrast_floor, !options_.gain_per_channel, rows + n * a,
+                           lane_colors, scratch + stride * a);
+  }
+  // PlainResiduals' against the mean, in place, then SummaryAt's sum in the residuals' order.
+  const Eigen::Vector3d weight = scale_ * weights_[b];
+  for (int m = 0; m < n; ++m) {
+    for (int channel = 0; channel < 3; ++channel) {
+      double* values = scratch + kLanes * (3 * m + channel);
+      Lanes<kLanes> mean = Lanes<kLanes>::Zero();
+      for (int a = 0; a < num_cameras; ++a) mean += LanesAt<kLanes>(values + stride * a);
+      for (int a = 0; a < num_cameras; ++a) {
+        auto value = LanesAt<kLanes>(values + stride * a);
+        value = weight[channel] * (value - mean / num_cameras);
+      }
+    }
+  }
+  Lanes<kLanes> squared_norm = Lanes<kLanes>::Zero();
+  for (int i = 0; i < 3 * num_cameras * n; ++i) {
+    squared_norm += LanesAt<kLanes>(scratch + kLanes * i).square();
+  }
+  const double c2 = LossScale(b);
+  for (int lane = 0; lane < kLanes; ++lane) {
+    BlockSummary plain;
+    plain.squared_norm = squared_norm[lane];
+    costs[lane] = Robustify(c2, plain, false).squared_norm;
   }
 }
 

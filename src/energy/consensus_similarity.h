@@ -78,9 +78,14 @@ class ConsensusSimilarity : public SimilarityTerm {
   // The tables hold all it reads of the pairs.
   bool ReadsPairLists() const override { return false; }
   // Each block's sum of squares without storing its residuals. Where every k_s is the same and
-  // the patches are flat (the plane sweep's samples), each pair-list row's colour is interpolated
-  // once instead of once for every patch it belongs to.
+  // the patches are flat, as UniformBlockCosts.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
+  // With flat patches (no shape set), each pair-list row's colour is interpolated once per
+  // displacement instead of once for every patch it belongs to, and each block's residuals are
+  // reduced to their sum of squares without being written, for several displacements at a time:
+  // the same operations as the residuals' in the same order, so the same costs to the bit.
+  void UniformBlockCosts(int num_parameters, const Eigen::VectorXd& displacements,
+                         Eigen::MatrixXd* costs) override;
 
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
   // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.
@@ -145,25 +150,33 @@ class ConsensusSimilarity : public SimilarityTerm {
   int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
   // The colours of block b's patch in each of its cameras with every member displaced by k along
   // its own normal (and the patch's shape), interpolated in the tables, and, when `derivatives`
-  // is not null, their k-derivatives; or, given `row_colors` (every table row's colour at this
-  // k, flat patches), read from them. Written camera after camera, member after member, channel
+  // is not null, their k-derivatives. Written camera after camera, member after member, channel
   // after channel: the order of the block's residuals.
-  void PatchColors(int b, double k, double* colors, double* derivatives,
-                   const Eigen::Vector3d* row_colors = nullptr) const;
+  void PatchColors(int b, double k, double* colors, double* derivatives) const;
   // The per-channel root mean variance of block b's patch over its cameras at the input surface.
   Eigen::Vector3d PatchContrast(int b) const;
   // The residuals of block b at displacement k of its patch before the robust loss, and, when
-  // `jacobian` is not null, their derivatives; `row_colors` as for PatchColors.
-  void PlainResiduals(int b, double k, double* residuals, double* jacobian,
-                      const Eigen::Vector3d* row_colors = nullptr) const;
+  // `jacobian` is not null, their derivatives.
+  void PlainResiduals(int b, double k, double* residuals, double* jacobian) const;
   // The scale c2 of block b's robust loss (none when not positive).
   double LossScale(int b) const;
   // Block b's residuals, and their derivatives when `jacobian` is not null.
   void BlockAt(int b, double k, double* residuals, double* jacobian) const;
   // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
   // applied to the sums instead of to every residual: what the solvers and the sweep need.
-  BlockSummary SummaryAt(int b, double k, bool with_derivatives,
-                         const Eigen::Vector3d* row_colors = nullptr) const;
+  BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
+  // Every block's cost, as SummaryAt's squared_norm, with all k_s at each of
+  // displacements[0 .. kLanes) and flat patches: costs[b + lane * column_stride]. Every table
+  // row's colour at each displacement goes to `lane_colors` (row, channel, lane).
+  template <int kLanes>
+  void UniformCosts(const double* displacements, double* costs, long column_stride,
+                    std::vector<double>* lane_colors) const;
+  // Block b's costs at the kLanes displacements of `lane_colors` (every table row's colour at
+  // each: row, channel, lane), lane by lane with SummaryAt's operations in its order. `scratch`
+  // holds 3 kLanes doubles per row of the block.
+  template <int kLanes>
+  void UniformCostsOfBlock(int b, const double* lane_colors, double* scratch,
+                           double costs[kLanes]) const;
 
   const SurfaceGaussians& surface_;
   const std::vector<EnergyView>& views_;
@@ -191,7 +204,7 @@ class ConsensusSimilarity : public SimilarityTerm {
   std::vector<int> first_row_;
   std::vector<TableNode> table_;
   Eigen::VectorXd shape_;
-  std::vector<Eigen::Vector3d> row_colors_;  // BlockCosts' colour of every table row.
+  int max_block_rows_ = 0;  // The most table rows a block reads.
 
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_;

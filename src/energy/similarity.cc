@@ -20,6 +20,16 @@ void SimilarityTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* c
   }
 }
 
+void SimilarityTerm::UniformBlockCosts(int num_parameters, const Eigen::VectorXd& displacements,
+                                       Eigen::MatrixXd* costs) {
+  costs->resize(static_cast<Eigen::Index>(residual_blocks().size()), displacements.size());
+  std::vector<double> block_costs;
+  for (int j = 0; j < displacements.size(); ++j) {
+    BlockCosts(Eigen::VectorXd::Constant(num_parameters, displacements[j]), &block_costs);
+    costs->col(j) = Eigen::Map<const Eigen::VectorXd>(block_costs.data(), costs->rows());
+  }
+}
+
 SimilarityTerm::BlockSummary SimilarityTerm::Summarise(const double* residuals,
                                                        const double* jacobian, int m) {
   BlockSummary summary;

@@ -12,15 +12,15 @@ namespace {
 Eigen::MatrixXd SweepCosts(FrameEnergy* energy, const Eigen::VectorXd& displacements) {
   SimilarityTerm& term = energy->similarity();
   const int n = energy->num_parameters();
+  Eigen::MatrixXd block_costs;
+  term.UniformBlockCosts(n, displacements, &block_costs);
   Eigen::MatrixXd costs = Eigen::MatrixXd::Zero(n, displacements.size());
   const auto& blocks = term.residual_blocks();
-  std::vector<double> block_costs;
+  // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
   for (int j = 0; j < displacements.size(); ++j) {
-    term.BlockCosts(Eigen::VectorXd::Constant(n, displacements[j]), &block_costs);
-    // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
     for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
       for (int s : blocks[b].parameters)
-        costs(s, j) += block_costs[b] / blocks[b].parameters.size();
+        costs(s, j) += block_costs(b, j) / blocks[b].parameters.size();
     }
   }
   return costs;

@@ -65,6 +65,11 @@ class SimilarityTerm {
   // costs[b] = the sum of squares of block b's residuals at k, for every block. Prepares the
   // residuals at k (without Jacobians) and sums them; a term may know a faster way.
   virtual void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs);
+  // costs(b, j) = BlockCosts' costs[b] with all `num_parameters` k_s at displacements[j]: the
+  // plane sweep's samples. BlockCosts at each displacement in turn; a term may know a faster
+  // way.
+  virtual void UniformBlockCosts(int num_parameters, const Eigen::VectorXd& displacements,
+                                 Eigen::MatrixXd* costs);
 
   // True when Evaluate(k) is exactly minus half the sum of squares of the residuals at k: then
   // the least-squares cost gives the similarity too, and a solver need not evaluate both.
