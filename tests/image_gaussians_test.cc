@@ -93,6 +93,22 @@ std::vector<int> BruteForce(const ImageGaussians& gaussians, Inside inside) {
   return found;
 }
 
+// The Gaussians within reach of the segment [start, end], by a scan of every one.
+std::vector<int> ReachingSegmentByScan(const ImageGaussians& gaussians,
+                                       const Eigen::Vector2d& start, const Eigen::Vector2d& end,
+                                       double sigma, double cutoff) {
+  return BruteForce(gaussians, [&](const ImageGaussian& g) {
+    const Eigen::Vector2d direction = end - start;
+    const Eigen::Vector2d offset = Eigen::Vector2d(g.x, g.y) - start;
+    const double length_squared = direction.squaredNorm();
+    const double t =
+        length_squared > 0.0 ? std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) : 0.0;
+    const double sigma_i = g.sigma, cutoff_squared = cutoff * cutoff;
+    return (offset - t * direction).squaredNorm() <=
+           cutoff_squared * sigma * sigma + cutoff_squared * sigma_i * sigma_i;
+  });
+}
+
 // Runs random FindWithin and FindReaching queries against a scan of every Gaussian.
 void ExpectQueriesMatchBruteForce(const ImageGaussians& gaussians, unsigned seed) {
   std::mt19937 rng(seed);
@@ -123,35 +139,9 @@ void ExpectQueriesMatchBruteForce(const ImageGaussians& gaussians, unsigned seed
     const Eigen::Vector2d end =
         p + radius(rng) * 1.5 * Eigen::Vector2d(std::cos(angle), std::sin(angle));
     gaussians.FindReachingSegment(p, end, s, c, &found);
-    const auto reaching_segment = [&](const ImageGaussian& g) {
-      const Eigen::Vector2d direction = end - p;
-      const Eigen::Vector2d offset = Eigen::Vector2d(g.x, g.y) - p;
-      const double length_squared = direction.squaredNorm();
-      const double t =
-          length_squared > 0.0 ? std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) : 0.0;
-      const double sigma_i = g.sigma, cutoff_squared = c * c;
-      return (offset - t * direction).squaredNorm() <=
-             cutoff_squared * s * s + cutoff_squared * sigma_i * sigma_i;
-    };
-    EXPECT_EQ(Sorted(found), BruteForce(gaussians, reaching_segment))
+    EXPECT_EQ(Sorted(found), ReachingSegmentByScan(gaussians, p, end, s, c))
         << "sigma " << s << " from " << p.transpose() << " to " << end.transpose();
   }
-}
-
-// The Gaussians within reach of the segment [start, end], by a scan of every one.
-std::vector<int> ReachingSegmentByScan(const ImageGaussians& gaussians,
-                                       const Eigen::Vector2d& start, const Eigen::Vector2d& end,
-                                       double sigma, double cutoff) {
-  return BruteForce(gaussians, [&](const ImageGaussian& g) {
-    const Eigen::Vector2d direction = end - start;
-    const Eigen::Vector2d offset = Eigen::Vector2d(g.x, g.y) - start;
-    const double length_squared = direction.squaredNorm();
-    const double t =
-        length_squared > 0.0 ? std::clamp(offset.dot(direction) / length_squared, 0.0, 1.0) : 0.0;
-    const double sigma_i = g.sigma, cutoff_squared = cutoff * cutoff;
-    return (offset - t * direction).squaredNorm() <=
-           cutoff_squared * sigma * sigma + cutoff_squared * sigma_i * sigma_i;
-  });
 }
 
 // Segments that a bound of the scan tighter than the exact test would cut: long diagonal ones
