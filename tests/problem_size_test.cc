@@ -72,7 +72,7 @@ TEST_F(ProblemSizeTest, SizesAreThoseOfThePreparedFrame) {
   EXPECT_EQ(size.num_pairs, prepared.energy->num_pairs());
   ASSERT_EQ(size.visible_per_camera.size(), input_.cameras.size());
   for (int seen : size.visible_per_camera) EXPECT_GT(seen, 0);
-  EXPECT_EQ(size.num_pixels, 3.0 * 96 * 96);
+  EXPECT_EQ(size.num_pixels, input_.cameras.size() * 96.0 * 96.0);
   EXPECT_GT(size.peak_memory_mb, 0.0);
   EXPECT_GT(size.seconds_per_frame, 0.0);
 }

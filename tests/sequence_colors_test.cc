@@ -39,7 +39,6 @@ SequenceOptions SurfaceColorOptions() {
 std::string MakeCapture(const std::string& root, int num_frames) {
   const std::string dir = root + "/capture";
   SynthOptions synth = testing_util::TinyRefinableSynthOptions(num_frames);
-  synth.cameras.count = 4;  // The consensus pass needs two cameras on a patch.
   synth.cameras.width = synth.cameras.height = 160;
   synth.cameras.focal = 500.0;
   GenerateSyntheticCapture(synth, dir);

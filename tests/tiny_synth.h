@@ -40,13 +40,16 @@ inline Config TinyRunConfig(const std::string& capture, const std::string& out,
   return config;
 }
 
-// TinySynthOptions with 3 cameras of 96 x 96 that see the skirt large and a 16 x 8 skirt:
-// still tiny, but each frame gives refinement something to do.
+// TinySynthOptions with 6 cameras of 96 x 96 that see the skirt large and a 16 x 8 skirt:
+// still tiny, but each frame gives refinement something to do. Six: the consensus similarity
+// compares a patch (a Gaussian and its ring, 45 degrees of the skirt) between two cameras that
+// both see all of it within their 60 degrees (VisibilityOptions::max_view_angle_deg); cameras 90
+// or 120 degrees apart share no such patch, and the energy would hold the regulariser alone.
 inline SynthOptions TinyRefinableSynthOptions(int num_frames) {
   SynthOptions options = TinySynthOptions();
   options.num_frames = num_frames;
   options.skirt.down = 8;
-  options.cameras.count = 3;
+  options.cameras.count = 6;
   options.cameras.width = 96;
   options.cameras.height = 96;
   options.cameras.focal = 300.0;

@@ -585,6 +585,7 @@ void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
   }
   const long num_blocks = static_cast<long>(blocks_.size());
   costs->resize(num_blocks, displacements.size());
+  if (num_blocks == 0) return;  // No column to write into: the matrix holds no storage.
   // Eight displacements at a time; the rest one at a time, so that no lane is computed in vain.
   constexpr int kLanes = 8;
   // The row colours live for this call only: at 24 bytes per row and lane, eight lanes take
@@ -592,10 +593,10 @@ void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
   std::vector<double> lane_colors;
   int j = 0;
   for (; j + kLanes <= displacements.size(); j += kLanes) {
-    UniformCosts<kLanes>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
+    UniformCosts<kLanes>(&displacements[j], costs->col(j).data(), num_blocks, &lane_colors);
   }
   for (; j < displacements.size(); ++j) {
-    UniformCosts<1>(&displacements[j], &(*costs)(0, j), num_blocks, &lane_colors);
+    UniformCosts<1>(&displacements[j], costs->col(j).data(), num_blocks, &lane_colors);
   }
 }
 

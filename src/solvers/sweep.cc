@@ -40,7 +40,12 @@ Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& opt
   Eigen::VectorXd k(n);
   for (int s = 0; s < n; ++s) {
     int best = 0;
-    costs.row(s).minCoeff(&best);
+    // A Gaussian whose curve is flat (no block reaches it, nor its neighbours' costs) has no
+    // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
+    if (costs.row(s).minCoeff(&best) == costs.row(s).maxCoeff()) {
+      k[s] = 0.0;
+      continue;
+    }
     k[s] = displacements[best];
     // Sub-sample position: the vertex of the parabola through the best sample and its neighbours.
     if (best > 0 && best + 1 < displacements.size()) {
