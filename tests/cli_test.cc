@@ -54,6 +54,18 @@ TEST(CliTest, HelpListsTheSubcommands) {
   EXPECT_NE(result.output.find("energy.similarity"), std::string::npos);
 }
 
+// libgomp prints the policy it took as it loads (OMP_DISPLAY_ENV): the executable's own
+// choice, workers that sleep (no spinning), unless the caller chose one.
+TEST(CliTest, OpenMpWorkersSleepUnlessTheCallerChoseAPolicy) {
+  const RunResult own = RunFinecap("--help", "OMP_DISPLAY_ENV=verbose ");
+  EXPECT_EQ(own.exit_code, 0);
+  EXPECT_NE(own.output.find("GOMP_SPINCOUNT = '0'"), std::string::npos)
+      << own.output.substr(0, 2000);
+  const RunResult callers = RunFinecap("--help", "OMP_DISPLAY_ENV=verbose OMP_WAIT_POLICY=active ");
+  EXPECT_NE(callers.output.find("OMP_WAIT_POLICY = 'ACTIVE'"), std::string::npos);
+  EXPECT_EQ(callers.output.find("GOMP_SPINCOUNT = '0'"), std::string::npos);
+}
+
 TEST(CliTest, MissingCaptureFolderIsNamedAndNothingIsWritten) {
   const fs::path folder = FreshFolder("missing");
   const fs::path out = folder / "out";

@@ -194,6 +194,9 @@ int Main(int argc, char** argv) {
   gflags::ParseCommandLineNonHelpFlags(&argc, &argv, /*remove_flags=*/true);
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
+  VLOG(1) << (SleepingWorkersSetByFinecap()
+                  ? "OpenMP's workers sleep between loops (OMP_WAIT_POLICY=passive)"
+                  : "OpenMP's wait policy is the environment's");
 
   if (FLAGS_config_keys_markdown) {
     Config defaults;
@@ -225,16 +228,6 @@ int Main(int argc, char** argv) {
 
 }  // namespace
 }  // namespace finecap
-
-namespace {
-
-// Runs before any shared library initialises, libgomp among them (PreferSleepingWorkers).
-void BeforeLibrariesInitialise(int, char**, char**) { finecap::PreferSleepingWorkers(); }
-__attribute__((section(".preinit_array"),
-               used)) void (*before_libraries_initialise)(int, char**,
-                                                          char**) = &BeforeLibrariesInitialise;
-
-}  // namespace
 
 int main(int argc, char** argv) {
   finecap::UseOneMallocArena();

@@ -4,7 +4,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <cstdlib>
 
 #include "finecap/util/error.h"
 
@@ -15,11 +14,6 @@ void SetWorkerThreads(int threads) {
   // OpenMP's own default, remembered before anything changes it.
   static const int default_threads = omp_get_max_threads();
   omp_set_num_threads(threads > 0 ? threads : default_threads);
-}
-
-void PreferSleepingWorkers() {
-  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
-  setenv("OMP_WAIT_POLICY", "passive", 1);  // On failure the workers spin, as by default.
 }
 
 void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }

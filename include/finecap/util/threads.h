@@ -17,13 +17,12 @@ void SetWorkerThreads(int threads);
 
 // OpenMP's workers (libgomp's default) spin for a while after each parallel loop, waiting for the
 // next. Between the loops Ceres runs its own threads and the frame reader reads and prepares the
-// next frame, and a spinning worker takes a core from them. This makes the workers sleep instead
-// (OMP_WAIT_POLICY=passive), unless the caller set OMP_WAIT_POLICY or GOMP_SPINCOUNT. libgomp
-// reads the policy once, as it loads, before main() runs: call this from the program's
-// .preinit_array, whose functions run before any shared library's initialiser (tools/finecap.cc).
-// (Restarting the process with the variable set, as finecap once did, loads its ~270 shared
-// libraries twice: 0.2 s of every run.)
-void PreferSleepingWorkers();
+// next frame, and a spinning worker takes a core from them. The finecap executable makes them
+// sleep instead (OMP_WAIT_POLICY=passive) unless the caller set OMP_WAIT_POLICY or
+// GOMP_SPINCOUNT: libgomp reads the policy once, as it loads, so a library of its own sets it
+// from its constructor (src/sleeping_workers/sleeping_workers.cc). This says whether it did;
+// only the executable links that library.
+bool SleepingWorkersSetByFinecap();
 
 // glibc gives each thread that allocates while another holds the lock an arena of its own, up to
 // eight per core, and memory freed into an arena stays there for that arena's next allocations.
