@@ -24,7 +24,10 @@
 # reached" when no budget gets there) and ceres_to_ascent_speed_ratio; ceres_solve_seconds,
 # ascent_solve_seconds_at_ceres_rms and ceres_to_ascent_solve_ratio. Frames per minute are 60
 # over the median over the runs of the mean seconds per frame; RMS is over frames of the
-# per-frame RMS error of k against the truth.
+# per-frame RMS error of k against the truth. Then where Ceres' solve goes:
+# ceres_iterations_per_frame, ceres_similarity_seconds (the similarity's shared work a frame),
+# ceres_own_seconds (the rest: Ceres' pass over the residual blocks, linear solver and steps),
+# ceres_ms_per_iteration, and per budget ascent_N_ms_per_evaluation.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${FRAMES:-8}
@@ -60,9 +63,10 @@ run() {
   build/finecap refine --capture "$work/capture" --out "$dir" "$@" >/dev/null 2>&1
   seconds[$key]+=" $(mean_of seconds "$dir/stats.jsonl")"
   solve[$key]+=" $(mean_of seconds_solve "$dir/stats.jsonl")"
+  similarity[$key]+=" $(mean_of seconds_similarity "$dir/stats.jsonl")"
 }
 
-declare -A seconds solve
+declare -A seconds solve similarity
 for ((i = 0; i < repeats; ++i)); do
   run ceres "$work/ceres" --solver ceres
   for n in $budgets; do
@@ -110,3 +114,17 @@ else
   echo "ascent_solve_seconds_at_ceres_rms: $(echo "$solve_at_target" | awk '{ printf "%.3f", $1 }')"
   echo "ceres_to_ascent_solve_ratio: $(echo "$solve_at_target $ceres_solve" | awk '{ printf "%.2f", $1 / $2 }')"
 fi
+# Where Ceres' solve goes: its iterations, and of its time the similarity's shared work (what an
+# iteration of the ascent is, nearly all) against Ceres' own (its pass over the residual blocks,
+# the linear solver, its steps).
+ceres_iterations=$(mean_of iterations "$work/ceres/stats.jsonl")
+ceres_similarity=$(echo "${similarity[ceres]}" | median)
+echo "ceres_iterations_per_frame: $(echo "$ceres_iterations" | awk '{ printf "%.1f", $1 }')"
+echo "ceres_similarity_seconds: $ceres_similarity"
+echo "ceres_own_seconds: $(echo "$ceres_solve $ceres_similarity" | awk '{ printf "%.3f", $1 - $2 }')"
+echo "ceres_ms_per_iteration: $(echo "$ceres_solve $ceres_iterations" | awk '{ printf "%.1f", 1000 * $1 / $2 }')"
+for n in $budgets; do
+  s=$(echo "${solve[$n]}" | median)
+  evaluations=$(mean_of evaluations "$work/ascent_$n/stats.jsonl")
+  echo "ascent_${n}_ms_per_evaluation: $(echo "$s $evaluations" | awk '{ printf "%.1f", 1000 * $1 / $2 }')"
+done

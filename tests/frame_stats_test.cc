@@ -29,6 +29,7 @@ FrameStats SampleStats() {
   stats.seconds_solve = 1.0;
   stats.seconds_evaluation = 0.125;
   stats.seconds_linear_solver = 0.0625;
+  stats.seconds_similarity = 0.03125;
   stats.surface_gaussians = 10112;
   stats.image_gaussians = 123456789012L;
   stats.pairs = 821000;
@@ -62,7 +63,8 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
        {&FrameStats::energy_start, &FrameStats::energy_end, &FrameStats::ls_cost_start,
         &FrameStats::ls_cost_end, &FrameStats::seconds, &FrameStats::seconds_preparation,
         &FrameStats::seconds_solve, &FrameStats::seconds_evaluation,
-        &FrameStats::seconds_linear_solver, &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
+        &FrameStats::seconds_linear_solver, &FrameStats::seconds_similarity,
+        &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
         &FrameStats::rms_textureless_coarse_mm, &FrameStats::rms_textureless_refined_mm}) {
     ExpectSameReal(stats.*field, back.*field);
   }

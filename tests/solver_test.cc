@@ -271,6 +271,9 @@ TEST(FrameSolverTest, PassesOnOneProblemTakeTheStepsOfFreshProblems) {
         << pass;
     EXPECT_NEAR(kept[pass].ls_cost_end, fresh[pass].ls_cost_end, 1e-12 * fresh[pass].ls_cost_end)
         << pass;
+    // Each pass reports its own share of the similarity's work, a part of its evaluation.
+    EXPECT_GT(kept[pass].seconds_similarity, 0.0) << pass;
+    EXPECT_LE(kept[pass].seconds_similarity, kept[pass].seconds_evaluation) << pass;
   }
   EXPECT_LE((k_kept - k_fresh).norm(), 1e-12 * k_fresh.norm());
   consensus->SetPatchShape(flat);

@@ -41,6 +41,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.seconds_solve = summary.seconds;
   stats.seconds_evaluation = summary.seconds_evaluation;
   stats.seconds_linear_solver = summary.seconds_linear_solver;
+  stats.seconds_similarity = summary.seconds_similarity;
   stats.surface_gaussians = result.num_surface_gaussians;
   stats.image_gaussians = result.num_image_gaussians;
   stats.pairs = result.num_pairs;
@@ -68,6 +69,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"seconds_solve\": " << JsonNumber(s.seconds_solve)
        << ", \"seconds_evaluation\": " << JsonNumber(s.seconds_evaluation)
        << ", \"seconds_linear_solver\": " << JsonNumber(s.seconds_linear_solver)
+       << ", \"seconds_similarity\": " << JsonNumber(s.seconds_similarity)
        << ", \"seconds_heldout\": " << JsonNumber(s.seconds_heldout)
        << ", \"surface_gaussians\": " << s.surface_gaussians
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
@@ -111,6 +113,7 @@ struct StatsFields {
       {"seconds_solve", &FrameStats::seconds_solve},
       {"seconds_evaluation", &FrameStats::seconds_evaluation},
       {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
+      {"seconds_similarity", &FrameStats::seconds_similarity},
       {"seconds_heldout", &FrameStats::seconds_heldout},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},

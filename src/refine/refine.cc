@@ -209,11 +209,7 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     const SolverSummary more = solver.Solve(k);
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;
-    summary.iterations += more.iterations;
-    summary.evaluations += more.evaluations;
-    summary.seconds += more.seconds;
-    summary.seconds_evaluation += more.seconds_evaluation;
-    summary.seconds_linear_solver += more.seconds_linear_solver;
+    summary.AddWork(more);
     summary.termination = more.termination;
     summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
   }
@@ -258,11 +254,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     *seconds_preparation += frame.seconds;
     if (k.size() == 0) k = starting_point(&frame);
     const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
-    totals->iterations += summary.iterations;
-    totals->evaluations += summary.evaluations;
-    totals->seconds += summary.seconds;
-    totals->seconds_evaluation += summary.seconds_evaluation;
-    totals->seconds_linear_solver += summary.seconds_linear_solver;
+    totals->AddWork(summary);
   }
   return k;
 }
@@ -299,11 +291,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
                           &result.summary.ls_cost_start);
     EvaluateEnergyAndCost(&energy, k, &result.summary.energy_end, &result.summary.ls_cost_end);
-    result.summary.iterations += coarse.iterations;
-    result.summary.evaluations += coarse.evaluations;
-    result.summary.seconds += coarse.seconds;
-    result.summary.seconds_evaluation += coarse.seconds_evaluation;
-    result.summary.seconds_linear_solver += coarse.seconds_linear_solver;
+    result.summary.AddWork(coarse);
   }
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;

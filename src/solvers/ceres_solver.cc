@@ -87,6 +87,7 @@ void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clo
   ceres::Solver::Options ceres_options = MakeCeresOptions(options);
   TraceRecorder recorder(clock, summary);
   ceres_options.callbacks.push_back(&recorder);
+  const double seconds_shared_before = seconds_shared_;
   StopOnSmallDecrease stop(options.function_tolerance);
   ceres_options.callbacks.push_back(&stop);
   ceres::Solver::Summary ceres_summary;
@@ -106,6 +107,7 @@ void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clo
   summary->seconds_evaluation = ceres_summary.residual_evaluation_time_in_seconds +
                                 ceres_summary.jacobian_evaluation_time_in_seconds;
   summary->seconds_linear_solver = ceres_summary.linear_solver_time_in_seconds;
+  summary->seconds_similarity = seconds_shared_ - seconds_shared_before;
 }
 
 void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,

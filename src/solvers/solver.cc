@@ -28,6 +28,15 @@ void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double
   *energy_value = energy->similarity().IsLeastSquares() ? -*cost : energy->Evaluate(k, nullptr);
 }
 
+void SolverSummary::AddWork(const SolverSummary& more) {
+  iterations += more.iterations;
+  evaluations += more.evaluations;
+  seconds += more.seconds;
+  seconds_evaluation += more.seconds_evaluation;
+  seconds_linear_solver += more.seconds_linear_solver;
+  seconds_similarity += more.seconds_similarity;
+}
+
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {
   return FrameSolver(energy, options).Solve(k);
 }

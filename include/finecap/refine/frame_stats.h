@@ -29,7 +29,8 @@ struct FrameStats {
   double seconds_solve = 0.0;
   double seconds_evaluation = 0.0;     // Of the solve: residuals, Jacobians, energies.
   double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.
-  double seconds_heldout = 0.0;        // After the solve: the held-out score (validation.cameras).
+  double seconds_similarity = 0.0;  // Of the evaluation, Ceres only: the similarity's shared work.
+  double seconds_heldout = 0.0;     // After the solve: the held-out score (validation.cameras).
   int surface_gaussians = 0;
   long image_gaussians = 0;
   long pairs = 0;

@@ -102,8 +102,15 @@ struct SolverSummary {
   double seconds = 0.0;
   double seconds_evaluation = 0.0;     // Residuals, Jacobians, energies and gradients.
   double seconds_linear_solver = 0.0;  // Ceres only.
-  std::string termination;             // Why the solver stopped.
+  // Ceres only: of seconds_evaluation, the similarity's work shared by its residual blocks at
+  // each new point (SimilarityTerm::PrepareBlockSummaries, all threads); the rest is Ceres' own
+  // pass over the residual blocks.
+  double seconds_similarity = 0.0;
+  std::string termination;  // Why the solver stopped.
   std::vector<SolverIteration> trace;
+
+  // Adds `more`'s iterations, evaluations and times: a further pass or level of the same frame.
+  void AddWork(const SolverSummary& more);
 };
 
 // Maximises the energy over k (one entry per surface Gaussian, metres), starting from *k.
