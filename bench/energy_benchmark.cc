@@ -1,5 +1,6 @@
 // One evaluation of the energy and its gradient on a synth_skirt frame (10k surface Gaussians,
-// 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads; and the
+// 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads, and the
+// block summaries Ceres' evaluation callback prepares instead at the same point; and the
 // preparation of a frame (subdivision, visibility, image Gaussians, pair lists); one solve of it;
 // and reading a
 // frame's input (the coarse mesh and every camera's image, decoded and undistorted).
@@ -114,6 +115,19 @@ void BM_EnergyAndGradientAtSweep(benchmark::State& state) {
   omp_set_num_threads(omp_get_num_procs());
 }
 BENCHMARK(BM_EnergyAndGradientAtSweep)->Unit(benchmark::kMillisecond);
+
+// The same point, prepared as Ceres' evaluation callback prepares it: each block's |r|^2, J^T r and
+// J^T J (SimilarityTerm::PrepareBlockSummaries), on one thread.
+void BM_BlockSummariesAtSweep(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const RefineOptions options;
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
+  omp_set_num_threads(1);
+  for (auto _ : state) frame.energy->similarity().PrepareBlockSummaries(k);
+  omp_set_num_threads(omp_get_num_procs());
+}
+BENCHMARK(BM_BlockSummariesAtSweep)->Unit(benchmark::kMillisecond);
 
 // One solve of a prepared frame with Ceres and the linear solver named, from the plane sweep's
 // start, as the first of a frame's passes: the solver's own work around the evaluations, beside
