@@ -279,6 +279,29 @@ TEST(FrameSolverTest, PassesOnOneProblemTakeTheStepsOfFreshProblems) {
   consensus->SetPatchShape(flat);
 }
 
+// A frame's passes and levels add up: every count and time of the work, and nothing of where the
+// solve started or ended.
+TEST(SolverSummaryTest, AddWorkSumsCountsAndTimes) {
+  SolverSummary total;
+  total.iterations = 3;
+  total.evaluations = 4;
+  total.seconds = 0.5;
+  total.seconds_evaluation = 0.25;
+  total.seconds_linear_solver = 0.125;
+  total.seconds_similarity = 0.0625;
+  total.energy_start = -2.0;
+  SolverSummary pass = total;
+  pass.energy_start = -1.0;
+  total.AddWork(pass);
+  EXPECT_EQ(total.iterations, 6);
+  EXPECT_EQ(total.evaluations, 8);
+  EXPECT_EQ(total.seconds, 1.0);
+  EXPECT_EQ(total.seconds_evaluation, 0.5);
+  EXPECT_EQ(total.seconds_linear_solver, 0.25);
+  EXPECT_EQ(total.seconds_similarity, 0.125);
+  EXPECT_EQ(total.energy_start, -2.0);
+}
+
 // The problem Ceres is given (similarity blocks, one smoothness block per Gaussian) has the cost
 // LeastSquaresCost computes term by term, with the regulariser and a prior both present: every
 // pair and every prior is in exactly one block.
