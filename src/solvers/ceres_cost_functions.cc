@@ -76,7 +76,15 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
                                           double** jacobians) const {
   const int p = static_cast<int>(parameter_block_sizes().size());
   if (p == 1) {
-    EvaluateOneParameter(parameters[0][0], residuals, jacobians);
+    const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(block_);
+    if (jacobians == nullptr) {
+      ReducedOneParameterRows(summary, 0.0, residuals, nullptr);
+      return true;
+    }
+    const double curvature = curvature_.At(parameters[0][0], summary, secant_);
+    double jacobian[2];
+    ReducedOneParameterRows(summary, curvature, residuals, jacobian);
+    if (jacobians[0] != nullptr) std::copy_n(jacobian, 2, jacobians[0]);
     return true;
   }
   const int m = num_full_residuals_;
@@ -107,16 +115,15 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
   return true;
 }
 
-double ReducedSimilarityBlockCost::ModelCurvature(
-    double k, const SimilarityTerm::BlockSummary& summary) const {
-  if (!secant_) return summary.curvature;
+double BlockCurvature::At(double k, const SimilarityTerm::BlockSummary& summary, bool secant) {
+  if (!secant) return summary.curvature;
   // Steps shorter than this (metres) are rounding: their secant is noise.
   constexpr double kMinSpan = 1e-9;
   const bool moved = !has_last_ || std::abs(k - last_k_) > kMinSpan;
   double curvature = summary.curvature;
   if (has_last_ && moved) {
-    const double secant = (summary.gradient - last_gradient_) / (k - last_k_);
-    curvature = std::clamp(secant, kMinSecantFactor * summary.curvature,
+    const double secant_curvature = (summary.gradient - last_gradient_) / (k - last_k_);
+    curvature = std::clamp(secant_curvature, kMinSecantFactor * summary.curvature,
                            kMaxSecantFactor * summary.curvature);
     // J^T J >= g^2 / |r|^2 always (Cauchy-Schwarz); a lower h must not go below it.
     if (summary.squared_norm > 0.0) {
@@ -131,23 +138,20 @@ double ReducedSimilarityBlockCost::ModelCurvature(
   return curvature;
 }
 
-void ReducedSimilarityBlockCost::EvaluateOneParameter(double k, double* residuals,
-                                                      double** jacobians) const {
-  const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(block_);
-  if (jacobians == nullptr) {
+void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double curvature,
+                             double* residuals, double* jacobian) {
+  if (jacobian == nullptr) {
     residuals[0] = std::sqrt(summary.squared_norm);
     residuals[1] = 0.0;
     return;
   }
   // R = sqrt(h) and Q^T r = J^T r / R, h = J^T J but for the secant.
-  const double length = std::sqrt(ModelCurvature(k, summary));
+  const double length = std::sqrt(curvature);
   residuals[0] = length > 0.0 ? summary.gradient / length : 0.0;
   // What of r no step can reduce; rounding may make the difference a hair negative.
   residuals[1] = std::sqrt(std::max(0.0, summary.squared_norm - residuals[0] * residuals[0]));
-  if (jacobians[0] != nullptr) {
-    jacobians[0][0] = length;
-    jacobians[0][1] = 0.0;
-  }
+  jacobian[0] = length;
+  jacobian[1] = 0.0;
 }
 
 IsolatedSimilarityBlockCost::IsolatedSimilarityBlockCost(SimilarityTerm* term, int block,
@@ -172,62 +176,73 @@ SmoothnessBlockCost::SmoothnessBlockCost(double prior_root, std::vector<Neighbou
 
 bool SmoothnessBlockCost::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const int num_parameters = static_cast<int>(parameter_block_sizes().size());
-  const double k = parameters[0][0];
-  if (jacobians != nullptr) {
-    for (int p = 0; p < num_parameters; ++p) {
-      if (jacobians[p] != nullptr) std::fill_n(jacobians[p], num_residuals(), 0.0);
-    }
+  Rows(prior_root_, neighbours_, static_cast<int>(parameter_block_sizes().size()), parameters,
+       residuals, jacobians, 0);
+  return true;
+}
+
+void SmoothnessBlockCost::Rows(double prior_root, const std::vector<Neighbour>& neighbours,
+                               int num_parameters, double const* const* parameters,
+                               double* residuals, double** jacobians, int first_row) {
+  const int num_rows = static_cast<int>(neighbours.size()) + (prior_root > 0.0 ? 1 : 0);
+  const auto jacobian = [&](int p) {
+    return jacobians != nullptr && jacobians[p] != nullptr ? jacobians[p] + first_row : nullptr;
+  };
+  for (int p = 0; p < num_parameters; ++p) {
+    if (double* column = jacobian(p)) std::fill_n(column, num_rows, 0.0);
   }
+  const double k = parameters[0][0];
+  double* own = jacobian(0);
   int r = 0;
-  if (prior_root_ > 0.0) {
-    residuals[r] = prior_root_ * k;
-    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][r] = prior_root_;
+  if (prior_root > 0.0) {
+    residuals[r] = prior_root * k;
+    if (own != nullptr) own[r] = prior_root;
     ++r;
   }
-  for (const Neighbour& neighbour : neighbours_) {
+  for (const Neighbour& neighbour : neighbours) {
     const double other = neighbour.parameter >= 0 ? parameters[neighbour.parameter][0] : 0.0;
     residuals[r] = neighbour.coefficient * (k - other);
-    if (jacobians != nullptr) {
-      if (jacobians[0] != nullptr) jacobians[0][r] = neighbour.coefficient;
-      if (neighbour.parameter >= 0 && jacobians[neighbour.parameter] != nullptr) {
-        jacobians[neighbour.parameter][r] = -neighbour.coefficient;
-      }
+    if (own != nullptr) own[r] = neighbour.coefficient;
+    if (neighbour.parameter >= 0) {
+      if (double* column = jacobian(neighbour.parameter)) column[r] = -neighbour.coefficient;
     }
     ++r;
   }
-  return true;
 }
 
 SurfaceGaussianCost::SurfaceGaussianCost(const SimilarityTerm& term, int similarity_block,
                                          bool secant, double prior_root,
                                          std::vector<SmoothnessBlockCost::Neighbour> neighbours,
                                          int num_free)
-    : similarity_(term, similarity_block, secant),
-      smoothness_(prior_root, std::move(neighbours), num_free) {
-  set_num_residuals(similarity_.num_residuals() + smoothness_.num_residuals());
-  *mutable_parameter_block_sizes() = smoothness_.parameter_block_sizes();
+    : term_(term),
+      similarity_block_(similarity_block),
+      secant_(secant),
+      prior_root_(prior_root),
+      neighbours_(std::move(neighbours)) {
+  set_num_residuals(2 + static_cast<int>(neighbours_.size()) + (prior_root_ > 0.0 ? 1 : 0));
+  mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
 bool SurfaceGaussianCost::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  const int num_similarity = similarity_.num_residuals();
-  if (jacobians == nullptr) {
-    return similarity_.Evaluate(parameters, residuals, nullptr) &&
-           smoothness_.Evaluate(parameters, residuals + num_similarity, nullptr);
-  }
-  // Each parameter block's Jacobian is one column (all blocks are 1-D): the similarity's rows
-  // first, zero but in k_s's column, then the smoothness rows.
   const int num_parameters = static_cast<int>(parameter_block_sizes().size());
-  thread_local std::vector<double*> smoothness_jacobians;
-  smoothness_jacobians.assign(num_parameters, nullptr);
-  for (int p = 0; p < num_parameters; ++p) {
-    if (jacobians[p] == nullptr) continue;
-    if (p > 0) std::fill_n(jacobians[p], num_similarity, 0.0);
-    smoothness_jacobians[p] = jacobians[p] + num_similarity;
+  const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(similarity_block_);
+  // Each parameter block's Jacobian is one column (all blocks are 1-D): the similarity's two rows
+  // first, zero but in k_s's column, then the smoothness rows.
+  if (jacobians == nullptr) {
+    ReducedOneParameterRows(summary, 0.0, residuals, nullptr);
+  } else {
+    double own[2];
+    ReducedOneParameterRows(summary, curvature_.At(parameters[0][0], summary, secant_), residuals,
+                            own);
+    if (jacobians[0] != nullptr) std::copy_n(own, 2, jacobians[0]);
+    for (int p = 1; p < num_parameters; ++p) {
+      if (jacobians[p] != nullptr) std::fill_n(jacobians[p], 2, 0.0);
+    }
   }
-  return similarity_.Evaluate(parameters, residuals, jacobians) &&
-         smoothness_.Evaluate(parameters, residuals + num_similarity, smoothness_jacobians.data());
+  SmoothnessBlockCost::Rows(prior_root_, neighbours_, num_parameters, parameters, residuals + 2,
+                            jacobians, 2);
+  return true;
 }
 
 namespace {
