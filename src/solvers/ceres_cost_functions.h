@@ -73,8 +73,8 @@ class BlockCurvature {
 };
 
 // The two residuals of a reduced similarity block of one parameter at a point with this summary,
-// and, unless `jacobian` is null, their Jacobian, for a model of curvature `curvature`
-// (ReducedSimilarityBlockCost).
+// and their Jacobian, for a model of curvature `curvature` (ReducedSimilarityBlockCost). With a
+// null `jacobian` the residuals are (|r|, 0), the cost alone, and `curvature` is not read.
 void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double curvature,
                              double* residuals, double* jacobian);
 
