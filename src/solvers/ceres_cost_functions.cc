@@ -76,15 +76,8 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
                                           double** jacobians) const {
   const int p = static_cast<int>(parameter_block_sizes().size());
   if (p == 1) {
-    const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(block_);
-    if (jacobians == nullptr) {
-      ReducedOneParameterRows(summary, 0.0, residuals, nullptr);
-      return true;
-    }
-    const double curvature = curvature_.At(parameters[0][0], summary, secant_);
-    double jacobian[2];
-    ReducedOneParameterRows(summary, curvature, residuals, jacobian);
-    if (jacobians[0] != nullptr) std::copy_n(jacobian, 2, jacobians[0]);
+    ReducedOneParameterRows(term_.BlockSummaryOf(block_), parameters[0][0], secant_, &curvature_,
+                            residuals, jacobians);
     return true;
   }
   const int m = num_full_residuals_;
@@ -138,20 +131,22 @@ double BlockCurvature::At(double k, const SimilarityTerm::BlockSummary& summary,
   return curvature;
 }
 
-void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double curvature,
-                             double* residuals, double* jacobian) {
-  if (jacobian == nullptr) {
+void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double k, bool secant,
+                             BlockCurvature* curvature, double* residuals, double** jacobians) {
+  if (jacobians == nullptr) {
     residuals[0] = std::sqrt(summary.squared_norm);
     residuals[1] = 0.0;
     return;
   }
   // R = sqrt(h) and Q^T r = J^T r / R, h = J^T J but for the secant.
-  const double length = std::sqrt(curvature);
+  const double length = std::sqrt(curvature->At(k, summary, secant));
   residuals[0] = length > 0.0 ? summary.gradient / length : 0.0;
   // What of r no step can reduce; rounding may make the difference a hair negative.
   residuals[1] = std::sqrt(std::max(0.0, summary.squared_norm - residuals[0] * residuals[0]));
-  jacobian[0] = length;
-  jacobian[1] = 0.0;
+  if (jacobians[0] != nullptr) {
+    jacobians[0][0] = length;
+    jacobians[0][1] = 0.0;
+  }
 }
 
 IsolatedSimilarityBlockCost::IsolatedSimilarityBlockCost(SimilarityTerm* term, int block,
@@ -170,7 +165,7 @@ bool IsolatedSimilarityBlockCost::Evaluate(double const* const* parameters, doub
 SmoothnessBlockCost::SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours,
                                          int num_free)
     : prior_root_(prior_root), neighbours_(std::move(neighbours)) {
-  set_num_residuals(static_cast<int>(neighbours_.size()) + (prior_root_ > 0.0 ? 1 : 0));
+  set_num_residuals(NumRows(prior_root_, neighbours_));
   mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
@@ -184,7 +179,7 @@ bool SmoothnessBlockCost::Evaluate(double const* const* parameters, double* resi
 void SmoothnessBlockCost::Rows(double prior_root, const std::vector<Neighbour>& neighbours,
                                int num_parameters, double const* const* parameters,
                                double* residuals, double** jacobians, int first_row) {
-  const int num_rows = static_cast<int>(neighbours.size()) + (prior_root > 0.0 ? 1 : 0);
+  const int num_rows = NumRows(prior_root, neighbours);
   const auto jacobian = [&](int p) {
     return jacobians != nullptr && jacobians[p] != nullptr ? jacobians[p] + first_row : nullptr;
   };
@@ -219,7 +214,7 @@ SurfaceGaussianCost::SurfaceGaussianCost(const SimilarityTerm& term, int similar
       secant_(secant),
       prior_root_(prior_root),
       neighbours_(std::move(neighbours)) {
-  set_num_residuals(2 + static_cast<int>(neighbours_.size()) + (prior_root_ > 0.0 ? 1 : 0));
+  set_num_residuals(2 + SmoothnessBlockCost::NumRows(prior_root_, neighbours_));
   mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
@@ -229,13 +224,8 @@ bool SurfaceGaussianCost::Evaluate(double const* const* parameters, double* resi
   const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(similarity_block_);
   // Each parameter block's Jacobian is one column (all blocks are 1-D): the similarity's two rows
   // first, zero but in k_s's column, then the smoothness rows.
-  if (jacobians == nullptr) {
-    ReducedOneParameterRows(summary, 0.0, residuals, nullptr);
-  } else {
-    double own[2];
-    ReducedOneParameterRows(summary, curvature_.At(parameters[0][0], summary, secant_), residuals,
-                            own);
-    if (jacobians[0] != nullptr) std::copy_n(own, 2, jacobians[0]);
+  ReducedOneParameterRows(summary, parameters[0][0], secant_, &curvature_, residuals, jacobians);
+  if (jacobians != nullptr) {
     for (int p = 1; p < num_parameters; ++p) {
       if (jacobians[p] != nullptr) std::fill_n(jacobians[p], 2, 0.0);
     }

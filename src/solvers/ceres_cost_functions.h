@@ -72,11 +72,12 @@ class BlockCurvature {
   double last_k_ = 0.0, last_gradient_ = 0.0;
 };
 
-// The two residuals of a reduced similarity block of one parameter at a point with this summary,
-// and their Jacobian, for a model of curvature `curvature` (ReducedSimilarityBlockCost). With a
-// null `jacobian` the residuals are (|r|, 0), the cost alone, and `curvature` is not read.
-void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double curvature,
-                             double* residuals, double* jacobian);
+// The two residuals of a reduced similarity block of one parameter at k, a point with this
+// summary, and their Jacobian in k's column (ReducedSimilarityBlockCost), its curvature modelled by
+// `curvature`. `jacobians` as Ceres passes them: null for the cost alone (the residuals are then
+// (|r|, 0) and the history is left as it is), else its first column, which may be null.
+void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double k, bool secant,
+                             BlockCurvature* curvature, double* residuals, double** jacobians);
 
 // The same residual block, reduced for the solver to at most p + 1 residuals for its p
 // parameters (two for one parameter, from SimilarityTerm::BlockSummaryOf): with J = Q R (Q with
@@ -165,6 +166,10 @@ class SmoothnessBlockCost : public ceres::CostFunction {
   static void Rows(double prior_root, const std::vector<Neighbour>& neighbours, int num_parameters,
                    double const* const* parameters, double* residuals, double** jacobians,
                    int first_row);
+  // How many residuals Rows writes.
+  static int NumRows(double prior_root, const std::vector<Neighbour>& neighbours) {
+    return static_cast<int>(neighbours.size()) + (prior_root > 0.0 ? 1 : 0);
+  }
 
  private:
   double prior_root_;
