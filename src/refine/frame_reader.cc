@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <memory>
 #include <utility>
 
 #include <omp.h>
@@ -117,19 +118,34 @@ FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable,
       threads_(omp_get_max_threads()) {}
 
 void FrameReadAhead::DropPending() {
-  if (pending_.valid()) pending_.wait();
-  pending_ = {};
+  for (Pending& pending : pending_) pending.read.wait();
+  pending_.clear();
 }
 
 void FrameReadAhead::ReadAhead(int frame) {
-  if (pending_.valid() || kept_frame_ == frame) return;
-  pending_frame_ = frame;
-  pending_ = std::async(std::launch::async, [this, frame] {
+  if (kept_frame_ == frame) return;
+  for (const Pending& pending : pending_) {
+    if (pending.frame == frame) return;
+  }
+  const std::shared_future<void> before =
+      pending_.empty() ? std::shared_future<void>() : pending_.back().ended;
+  auto ended = std::make_shared<std::promise<void>>();
+  Pending pending;
+  pending.frame = frame;
+  pending.ended = ended->get_future().share();
+  pending.read = std::async(std::launch::async, [this, frame, before, ended] {
+    // Tells the read queued behind this one to start, however this one ends.
+    struct SignalEnd {
+      std::promise<void>* ended;
+      ~SignalEnd() { ended->set_value(); }
+    } signal{ended.get()};
+    if (before.valid()) before.wait();
     // Named, so that a profile tells the frame ahead's work (and that of the OpenMP workers this
     // thread starts, which take its name) from the solve's.
     pthread_setname_np(pthread_self(), "finecap-ahead");
     return Read(frame, true);
   });
+  pending_.push_back(std::move(pending));
 }
 
 void FrameReadAhead::Keep(int frame, Frame read) {
@@ -142,8 +158,12 @@ FrameReadAhead::Frame FrameReadAhead::Take(int frame) {
   Frame kept = std::move(kept_);
   kept_ = {};
   if (kept_frame == frame) return kept;
-  if (pending_.valid() && pending_frame_ == frame) return pending_.get();
-  DropPending();  // A read of another frame.
+  if (!pending_.empty() && pending_.front().frame == frame) {
+    std::future<Frame> read = std::move(pending_.front().read);
+    pending_.pop_front();
+    return read.get();
+  }
+  DropPending();  // Reads of other frames.
   return Read(frame, false);
 }
 

@@ -4,6 +4,7 @@
 #ifndef FINECAP_REFINE_FRAME_READER_H_
 #define FINECAP_REFINE_FRAME_READER_H_
 
+#include <deque>
 #include <functional>
 #include <future>
 #include <optional>
@@ -42,11 +43,13 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
 std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // Reads frames as refinement sees them (ReadFrameInput with `skip_unreadable`, the cameras named
-// in `held_out` set aside, and, given `image_options`, the images modelled) one frame ahead on a
-// thread of its own, so that reading and modelling the next frame overlap solving this one; and,
-// given `work_ahead`, does that work on each frame read as well (a sequence prepares the frame's
-// energy there: PrepareFrameAhead). Only this reader may read from the capture while a read is
-// under way; at most one frame is read ahead and one kept (bounded memory).
+// in `held_out` set aside, and, given `image_options`, the images modelled) ahead on a thread of
+// their own, so that reading and modelling the next frames overlap solving this one; and, given
+// `work_ahead`, does that work on each frame read as well (a sequence prepares the frame's energy
+// there: PrepareFrameAhead). Reads asked for ahead run one after another, in the order asked for,
+// so that the work ahead takes one thread and its OpenMP team however far it reads. Only this
+// reader may read from the capture while a read is under way. Memory grows with the frames read
+// ahead and not yet taken (the caller bounds them) and the one kept.
 class FrameReadAhead {
  public:
   struct Frame {
@@ -66,8 +69,8 @@ class FrameReadAhead {
   FrameReadAhead(Capture* capture, bool skip_unreadable, std::vector<std::string> held_out,
                  std::optional<ImageGaussianOptions> image_options, WorkAhead work_ahead = {});
 
-  // Starts reading `frame` in the background, unless a read is already under way or the frame
-  // is kept.
+  // Starts reading `frame` in the background once the reads asked for before it have ended,
+  // unless it is kept or already asked for.
   void ReadAhead(int frame);
 
   // Frame `frame`: the one kept or read ahead when it is that frame (a read's errors are thrown
@@ -79,7 +82,7 @@ class FrameReadAhead {
   // of another frame drops it (a resumed run may never refine it).
   void Keep(int frame, Frame read);
 
-  // Waits for a read under way and drops it: before what `work_ahead` uses goes away.
+  // Waits for the reads under way and drops them: before what `work_ahead` uses goes away.
   void DropPending();
 
  private:
@@ -92,9 +95,15 @@ class FrameReadAhead {
   std::vector<std::string> held_out_;
   std::optional<ImageGaussianOptions> image_options_;
   WorkAhead work_ahead_;
-  int threads_;  // OpenMP threads for the work ahead.
-  int pending_frame_ = -1;
-  std::future<Frame> pending_;
+  // A frame asked for ahead.
+  struct Pending {
+    int frame = -1;
+    std::future<Frame> read;
+    std::shared_future<void> ended;  // Ready once the read has ended, whether it threw or not.
+  };
+
+  int threads_;                  // OpenMP threads for the work ahead.
+  std::deque<Pending> pending_;  // In the order asked for: each read waits for the one before.
   int kept_frame_ = -1;
   Frame kept_;
 };
