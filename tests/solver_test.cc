@@ -122,7 +122,8 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
   for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 20)) {
     if (term.residual_blocks()[b].parameters.size() != 1) continue;
     const int s = term.residual_blocks()[b].parameters[0];
-    const SurfaceGaussianCost cost(term, b, true, 0.7, neighbours, 2);
+    const SurfaceGaussianCost cost(term, b, true, 0.7, neighbours.data(),
+                                   static_cast<int>(neighbours.size()), 2);
     ASSERT_EQ(cost.num_residuals(), 2 + smoothness.num_residuals());
     ASSERT_EQ(cost.parameter_block_sizes().size(), 3u);
     const int m = cost.num_residuals();

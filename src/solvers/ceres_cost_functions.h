@@ -162,13 +162,14 @@ class SmoothnessBlockCost : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
   // The residuals (and, unless `jacobians` is null, their rows of each parameter block's Jacobian
-  // column, from row `first_row` on) of these smoothness terms.
-  static void Rows(double prior_root, const std::vector<Neighbour>& neighbours, int num_parameters,
-                   double const* const* parameters, double* residuals, double** jacobians,
-                   int first_row);
+  // column, from row `first_row` on) of the smoothness terms with `num_neighbours` neighbours
+  // from `neighbours` on.
+  static void Rows(double prior_root, const Neighbour* neighbours, int num_neighbours,
+                   int num_parameters, double const* const* parameters, double* residuals,
+                   double** jacobians, int first_row);
   // How many residuals Rows writes.
-  static int NumRows(double prior_root, const std::vector<Neighbour>& neighbours) {
-    return static_cast<int>(neighbours.size()) + (prior_root > 0.0 ? 1 : 0);
+  static int NumRows(double prior_root, int num_neighbours) {
+    return num_neighbours + (prior_root > 0.0 ? 1 : 0);
   }
 
  private:
@@ -191,10 +192,11 @@ class SmoothnessBlockCost : public ceres::CostFunction {
 class SurfaceGaussianCost : public ceres::CostFunction {
  public:
   // The similarity block as ReducedSimilarityBlockCost(term, similarity_block, secant) takes it,
-  // the smoothness residuals as SmoothnessBlockCost(prior_root, neighbours, num_free).
+  // the smoothness residuals as SmoothnessBlockCost(prior_root, neighbours, num_free) with the
+  // `num_neighbours` neighbours from `neighbours` on, which must outlive this object.
   SurfaceGaussianCost(const SimilarityTerm& term, int similarity_block, bool secant,
-                      double prior_root, std::vector<SmoothnessBlockCost::Neighbour> neighbours,
-                      int num_free);
+                      double prior_root, const SmoothnessBlockCost::Neighbour* neighbours,
+                      int num_neighbours, int num_free);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
   void ForgetHistory() const { curvature_.Forget(); }
@@ -203,13 +205,15 @@ class SurfaceGaussianCost : public ceres::CostFunction {
   // One cost function, not one of each kind inside it: Ceres and this object read the block's
   // data at every evaluation, and a Gaussian's block is 112 bytes and two allocations instead of
   // 248 and five (on synth_skirt frame 3, alone, five runs of each in turn: Ceres' evaluation
-  // 0.129 -> 0.118 s, the solve 0.202 -> 0.193 s, medians; the same steps).
+  // 0.129 -> 0.118 s, the solve 0.202 -> 0.193 s, medians; the same steps). The neighbours live
+  // in one array for all the Gaussians (FrameCostFunctions), not one allocation each.
   const SimilarityTerm& term_;
   int similarity_block_;
   bool secant_;
   mutable BlockCurvature curvature_;  // Ceres evaluates a block from one thread at a time.
   double prior_root_;
-  std::vector<SmoothnessBlockCost::Neighbour> neighbours_;
+  const SmoothnessBlockCost::Neighbour* neighbours_;
+  int num_neighbours_;
 };
 
 // The cost functions of one solve and the residual blocks they make. The problem does not own
@@ -224,7 +228,8 @@ class FrameCostFunctions {
   enum class Layout { kPerGaussian, kSeparate };
 
   // Adds the least-squares form of `energy` to `problem`, over the parameter blocks &(*k)[s],
-  // each bounded by k_max. `secant`: CurvatureModel::kSecant.
+  // each bounded by k_max. `secant`: CurvatureModel::kSecant. Once per object: its cost functions
+  // read arrays that it holds.
   void AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout, Eigen::VectorXd* k,
                          ceres::Problem* problem);
   // Forgets every similarity block's secant history (ReducedSimilarityBlockCost::ForgetHistory).
@@ -236,6 +241,8 @@ class FrameCostFunctions {
   std::vector<int> AddSimilarityBlocks(const SimilarityTerm& term, bool secant, Layout layout,
                                        Eigen::VectorXd* k, ceres::Problem* problem);
 
+  // Every SurfaceGaussianCost's neighbours, Gaussian after Gaussian.
+  std::vector<SmoothnessBlockCost::Neighbour> neighbours_;
   // Elements of a deque stay where they are as it grows: the problem holds their addresses.
   std::deque<ReducedSimilarityBlockCost> similarity_;
   std::deque<SmoothnessBlockCost> smoothness_;
