@@ -320,8 +320,9 @@ class SequenceRun {
   // ahead are prepared without their images, else one. A frame's preparation and the solve of
   // the one before share the cores, and each takes longer on some frames than on others; with one
   // frame ahead, the reader waited for the solve on some frames and the solve for the reader on
-  // others, and one core in seven was idle on synth_skirt. A prepared frame without its images is
-  // small beside a frame's images (tens of megabytes against the images' hundreds, on synth_skirt).
+  // others, and one core in seven was idle on synth_skirt (30 frames: 200 -> 214 frames per
+  // minute with two). A frame kept with its images would hold them all the while; prepared
+  // without them, the second frame ahead cost synth_skirt's runs ~6 MB of peak memory.
   void ReadAheadAfter(int frame, const FrameRange& frames) {
     int wanted = DropsImagesAhead() ? 2 : 1;
     for (int next = frame + 1; next < frames.end && wanted > 0; ++next) {
