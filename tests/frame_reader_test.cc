@@ -86,7 +86,9 @@ TEST_F(FrameReadAheadTest, ReadsTheFramesAskedForInOrderOneAtATime) {
   reader.ReadAhead(2);
   reader.ReadAhead(1);  // Asked for already: not read twice.
   const FrameReadAhead::Frame first = reader.Take(1);
+  EXPECT_TRUE(reader.ReadsAhead());
   const FrameReadAhead::Frame second = reader.Take(2);
+  EXPECT_FALSE(reader.ReadsAhead());
   EXPECT_TRUE(IsFrame(&capture, first, 1));
   EXPECT_TRUE(IsFrame(&capture, second, 2));
   EXPECT_EQ(log.frames(), (std::vector<int>{1, 2}));

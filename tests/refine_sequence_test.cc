@@ -3,9 +3,11 @@
 // the observer hears.
 #include "finecap/refine/sequence.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -170,6 +172,22 @@ TEST(RefineSequenceTest, ReferenceColoursOfAnotherRecipeAreRefused) {
         RefineSequence(&capture, {0, 2}, wider, out);
       },
       {"reference_colors.txt", "sigma_hat"});
+}
+
+// Ceres leaves the frame ahead one of the threads it was given, keeps at least one, and the rest
+// of the options as they were.
+TEST(RefineSequenceTest, CeresBesideTheFrameAheadTakesOneThreadFewer) {
+  SolverOptions configured;
+  configured.max_iterations = 7;
+  configured.num_threads = 4;
+  const SolverOptions beside = SolverOptionsBesideWorkAhead(configured);
+  EXPECT_EQ(beside.num_threads, 3);
+  EXPECT_EQ(beside.max_iterations, 7);
+  configured.num_threads = 1;
+  EXPECT_EQ(SolverOptionsBesideWorkAhead(configured).num_threads, 1);
+  configured.num_threads = 0;  // All cores.
+  const int cores = static_cast<int>(std::thread::hardware_concurrency());
+  EXPECT_EQ(SolverOptionsBesideWorkAhead(configured).num_threads, std::max(1, cores - 1));
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <thread>
 
 #include "finecap/measure/metrics.h"
 #include "finecap/solvers/solver_trace.h"
@@ -343,11 +344,14 @@ class SequenceRun {
     ReadAheadAfter(frame, frames);
     const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
     const ReferenceColors colors = ColorsFor(frame);
-    FrameResult result = warm_start.size() > 0
-                             ? RefineFrameFrom(model_, colors, input, options_.refine, warm_start,
-                                               std::move(read.prepared))
-                             : RefineFrame(model_, colors, input, options_.refine, nullptr,
-                                           std::move(read.prepared));
+    RefineOptions refine = options_.refine;
+    if (prepare_ahead_ && reader_.ReadsAhead()) {
+      refine.solver = SolverOptionsBesideWorkAhead(refine.solver);
+    }
+    FrameResult result =
+        warm_start.size() > 0
+            ? RefineFrameFrom(model_, colors, input, refine, warm_start, std::move(read.prepared))
+            : RefineFrame(model_, colors, input, refine, nullptr, std::move(read.prepared));
     if (result.num_surface_gaussians == 0) observer_->NothingToRefine(name);
 
     FrameStats stats = MakeFrameStats(name, options_.refine, result);
@@ -417,6 +421,15 @@ std::string ReferenceColorRecipe(const SequenceOptions& options) {
     recipe << " reference_surface=refined reg_rings=" << refine.energy.reg_rings;
   }
   return recipe.str();
+}
+
+SolverOptions SolverOptionsBesideWorkAhead(const SolverOptions& configured) {
+  SolverOptions options = configured;
+  const int threads = configured.num_threads > 0
+                          ? configured.num_threads
+                          : static_cast<int>(std::thread::hardware_concurrency());
+  options.num_threads = std::max(1, threads - 1);
+  return options;
 }
 
 std::string FollowedColorRecipe(const SequenceOptions& options) {

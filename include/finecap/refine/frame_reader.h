@@ -85,6 +85,9 @@ class FrameReadAhead {
   // Waits for the reads under way and drops them: before what `work_ahead` uses goes away.
   void DropPending();
 
+  // Whether frames asked for ahead are still to be taken (their reads may have ended).
+  bool ReadsAhead() const { return !pending_.empty(); }
+
  private:
   // `ahead`: read on the reader's thread, beside the work on the caller's; else on the caller's,
   // which waits for it.
