@@ -66,7 +66,7 @@ class FrameReadAheadTest : public ::testing::Test {
   ::testing::AssertionResult IsFrame(Capture* capture, const FrameReadAhead::Frame& read,
                                      int frame) {
     const FrameInput expected = ReadFrameInput(capture, frame);
-    if (!read.input.coarse.vertices.isApprox(expected.coarse.vertices, 0.0)) {
+    if (read.input.coarse.vertices != expected.coarse.vertices) {
       return ::testing::AssertionFailure() << "another frame's mesh";
     }
     if (read.input.images.size() != expected.images.size()) {

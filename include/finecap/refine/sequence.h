@@ -105,9 +105,9 @@ RefineOptions ReferencePassOptions(const RefineOptions& configured, const Captur
 // own loops (its pass over the residual blocks and its linear algebra) on one thread fewer than
 // `configured` gives them (0: all cores), and at least one. The frame ahead's preparation keeps
 // a core busy all the while, and Ceres 2.1 deals its blocks to its threads in turn: on
-// synth_skirt, two cores, its loops on one thread took a frame from 0.273 to 0.267 s (30 frames,
-// five alternating runs, medians; 16 frames: 0.256 to 0.246 s). The similarity's shared work
-// keeps every thread.
+// synth_skirt, two cores, its loops on one thread took a frame from 0.264 to 0.255 s (30 frames,
+// five alternating runs, medians, every run faster). The similarity's shared work keeps every
+// thread.
 SolverOptions SolverOptionsBesideWorkAhead(const SolverOptions& configured);
 
 // What the followed colours saved after a frame depend on: ReferenceColorRecipe and the two
