@@ -27,7 +27,14 @@
 # per-frame RMS error of k against the truth. Then where Ceres' solve goes:
 # ceres_iterations_per_frame, ceres_similarity_seconds (the similarity's shared work a frame),
 # ceres_own_seconds (the rest: Ceres' pass over the residual blocks, linear solver and steps),
-# ceres_ms_per_iteration, and per budget ascent_N_ms_per_evaluation.
+# ceres_ms_per_iteration, and per budget ascent_N_ms_per_evaluation. And what the frame ratio
+# tends to on a machine whose cores are all busy, the CPU a frame costs (stats.jsonl
+# "cpu_seconds", medians over the runs of the means over the frames): ceres_cpu_seconds_per_frame,
+# ascent_cpu_seconds_per_frame_at_ceres_rms, ceres_to_ascent_cpu_ratio,
+# frame_without_iterations_cpu_seconds (the ascent with no iteration: reading, preparing, the
+# sweep, the energy at both ends and writing, which both solvers spend alike) and
+# ceres_to_ascent_cpu_ratio_if_ceres_evaluations_cost_the_ascents (Ceres' frame with each of its
+# evaluations costing one of the ascent's: the most its own work could leave the ratio at).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${FRAMES:-8}
@@ -64,11 +71,15 @@ run() {
   seconds[$key]+=" $(mean_of seconds "$dir/stats.jsonl")"
   solve[$key]+=" $(mean_of seconds_solve "$dir/stats.jsonl")"
   similarity[$key]+=" $(mean_of seconds_similarity "$dir/stats.jsonl")"
+  cpu[$key]+=" $(mean_of cpu_seconds "$dir/stats.jsonl")"
 }
 
-declare -A seconds solve similarity
+declare -A seconds solve similarity cpu
 for ((i = 0; i < repeats; ++i)); do
   run ceres "$work/ceres" --solver ceres
+  # No iteration: what a frame costs besides its solve's iterations (reading, preparing, the
+  # sweep, the energy at both ends, writing), the same for both solvers.
+  run base "$work/base" --solver gradient-ascent --set "solver.max_iterations=0"
   for n in $budgets; do
     run "$n" "$work/ascent_$n" --solver gradient-ascent \
       --set "solver.max_iterations=$n,solver.function_tolerance=0"
@@ -88,7 +99,7 @@ for n in $budgets; do
   rms=$(rms_of "$work/ascent_$n/stats.jsonl")
   echo "ascent_${n}_frames_per_minute: $(echo "$s" | awk '{ printf "%.1f", 60 / $1 }')"
   echo "ascent_${n}_rms_mm: $rms"
-  ladder+="$s $(echo "${solve[$n]}" | median) $rms"$'\n'
+  ladder+="$s $(echo "${solve[$n]}" | median) $rms $(echo "${cpu[$n]}" | median)"$'\n'
 done
 # Column $1 of the ladder (seconds per frame, or solve seconds) where it first reaches Ceres' RMS,
 # interpolated in RMS.
@@ -113,6 +124,23 @@ else
   echo "ceres_solve_seconds: $ceres_solve"
   echo "ascent_solve_seconds_at_ceres_rms: $(echo "$solve_at_target" | awk '{ printf "%.3f", $1 }')"
   echo "ceres_to_ascent_solve_ratio: $(echo "$solve_at_target $ceres_solve" | awk '{ printf "%.2f", $1 / $2 }')"
+  # Both cores busy, a frame's time follows its CPU: the CPU ratio is what the frame ratio tends to.
+  cpu_at_target=$(at_target 4)
+  ceres_cpu=$(echo "${cpu[ceres]}" | median)
+  base_cpu=$(echo "${cpu[base]}" | median)
+  echo "ceres_cpu_seconds_per_frame: $ceres_cpu"
+  echo "ascent_cpu_seconds_per_frame_at_ceres_rms: $(echo "$cpu_at_target" | awk '{ printf "%.3f", $1 }')"
+  echo "ceres_to_ascent_cpu_ratio: $(echo "$cpu_at_target $ceres_cpu" | awk '{ printf "%.2f", $1 / $2 }')"
+  echo "frame_without_iterations_cpu_seconds: $base_cpu"
+  # The ratio Ceres would reach if each of its evaluations cost the CPU of one of the ascent's
+  # (the similarity's work alone, none of Ceres' own), from the largest budget's CPU per evaluation.
+  last=${budgets##* }
+  ascent_evaluations=$(mean_of evaluations "$work/ascent_$last/stats.jsonl")
+  ceres_evaluations=$(mean_of evaluations "$work/ceres/stats.jsonl")
+  base_evaluations=$(mean_of evaluations "$work/base/stats.jsonl")
+  echo "ceres_to_ascent_cpu_ratio_if_ceres_evaluations_cost_the_ascents: $(echo \
+    "$cpu_at_target $base_cpu $(echo "${cpu[$last]}" | median) $ascent_evaluations $ceres_evaluations $base_evaluations" |
+    awk '{ per = ($3 - $2) / ($4 - $6); printf "%.2f", $1 / ($2 + ($5 - $6) * per) }')"
 fi
 # Where Ceres' solve goes: its iterations, and of its time the similarity's shared work (what an
 # iteration of the ascent is, nearly all) against Ceres' own (its pass over the residual blocks,

@@ -30,6 +30,7 @@ FrameStats SampleStats() {
   stats.seconds_evaluation = 0.125;
   stats.seconds_linear_solver = 0.0625;
   stats.seconds_similarity = 0.03125;
+  stats.cpu_seconds = 3.375;
   stats.surface_gaussians = 10112;
   stats.image_gaussians = 123456789012L;
   stats.pairs = 821000;
@@ -64,7 +65,7 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
         &FrameStats::ls_cost_end, &FrameStats::seconds, &FrameStats::seconds_preparation,
         &FrameStats::seconds_solve, &FrameStats::seconds_evaluation,
         &FrameStats::seconds_linear_solver, &FrameStats::seconds_similarity,
-        &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
+        &FrameStats::cpu_seconds, &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
         &FrameStats::rms_textureless_coarse_mm, &FrameStats::rms_textureless_refined_mm}) {
     ExpectSameReal(stats.*field, back.*field);
   }

@@ -114,6 +114,10 @@ TEST(RefineSequenceTest, RefinesTheFramesLeftAndReportsThem) {
   EXPECT_EQ(first_run.refined, std::vector<std::string>{"000000"});
   EXPECT_TRUE(FrameDone(FrameFilesIn(out, "000000", MeshFormat::kPly)));
   EXPECT_FALSE(FrameDone(FrameFilesIn(out, "000001", MeshFormat::kPly)));
+  // The frame's CPU: some, and no more than its time on every core of the machine.
+  const FrameStats record = Record(out, "000000");
+  EXPECT_GT(record.cpu_seconds, 0.0);
+  EXPECT_LE(record.cpu_seconds, record.seconds * std::max(1u, std::thread::hardware_concurrency()));
 
   CountingObserver second_run;
   const SequenceResult second = RefineSequence(&capture, {0, 2}, options, out, &second_run);

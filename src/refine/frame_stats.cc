@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <ctime>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -20,6 +21,12 @@ double PeakResidentMegabytes() {
   rusage usage = {};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes.
+}
+
+double ProcessCpuSeconds() {
+  timespec now = {};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
 }
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
@@ -71,6 +78,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"seconds_linear_solver\": " << JsonNumber(s.seconds_linear_solver)
        << ", \"seconds_similarity\": " << JsonNumber(s.seconds_similarity)
        << ", \"seconds_heldout\": " << JsonNumber(s.seconds_heldout)
+       << ", \"cpu_seconds\": " << JsonNumber(s.cpu_seconds)
        << ", \"surface_gaussians\": " << s.surface_gaussians
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
@@ -115,6 +123,7 @@ struct StatsFields {
       {"seconds_linear_solver", &FrameStats::seconds_linear_solver},
       {"seconds_similarity", &FrameStats::seconds_similarity},
       {"seconds_heldout", &FrameStats::seconds_heldout},
+      {"cpu_seconds", &FrameStats::cpu_seconds},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},

@@ -164,11 +164,13 @@ Eigen::VectorXd WarmStart(const std::string& out, const Capture& capture, int fr
 // Writes the frame's files, its record last (it marks the frame done).
 void WriteFrame(const FrameFiles& files, const FrameResult& result, MeshFormat format,
                 FrameStats* stats, std::chrono::steady_clock::time_point start,
-                const StatsLog& log) {
+                double cpu_seconds_at_start, const StatsLog& log) {
   const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
   WriteMesh(files.mesh, result.refined, {result.normals, {}, quality}, format);
   WriteDisplacement(files.displacement, result.k);
   WriteTextFileAtomically(files.trace, SolverTraceCsv(result.summary.trace));
+  // Inside the frame's time, so that the CPU is never more than that time on every core.
+  stats->cpu_seconds = ProcessCpuSeconds() - cpu_seconds_at_start;
   stats->seconds = SecondsSince(start);
   const std::string record = ToJson(*stats);
   WriteTextFileAtomically(files.stats, record + "\n");
@@ -336,6 +338,7 @@ class SequenceRun {
   FrameStats RefineOne(int frame, const FrameRange& frames) {
     const std::string& name = capture_->frame_name(frame);
     const auto start = std::chrono::steady_clock::now();
+    const double cpu_seconds_at_start = ProcessCpuSeconds();
     FrameReadAhead::Frame read = reader_.Take(frame);
     ReportSkipped(frame, read.skipped);
     FrameInput& input = read.input;
@@ -363,7 +366,7 @@ class SequenceRun {
       SaveFollowedColors(name, colors, input, result, stats.worse);
     }
     WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
-               start, log_);
+               start, cpu_seconds_at_start, log_);
     return stats;
   }
 

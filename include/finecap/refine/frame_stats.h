@@ -31,6 +31,12 @@ struct FrameStats {
   double seconds_linear_solver = 0.0;  // Of the solve: Ceres' linear solver.
   double seconds_similarity = 0.0;  // Of the evaluation, Ceres only: the similarity's shared work.
   double seconds_heldout = 0.0;     // After the solve: the held-out score (validation.cameras).
+  // The process's CPU time (user and system, every thread) over `seconds`: the frame's own work and
+  // whatever ran beside it (the preparation of the frames ahead). The frames' windows follow one
+  // another, so over a run its mean is the CPU a frame costs, and cpu_seconds / seconds the cores
+  // kept busy. On a machine whose cores are all busy, frames per minute follow the CPU per frame,
+  // whichever part of a frame's work it goes to.
+  double cpu_seconds = 0.0;
   int surface_gaussians = 0;
   long image_gaussians = 0;
   long pairs = 0;
@@ -64,6 +70,9 @@ struct FrameStats {
 
 // The peak resident memory of this process so far, MB of 2^20 bytes (getrusage's ru_maxrss).
 double PeakResidentMegabytes();
+
+// The CPU time this process has used so far, every thread, user and system, seconds.
+double ProcessCpuSeconds();
 
 FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options,
                           const FrameResult& result);
