@@ -101,8 +101,8 @@ for n in $budgets; do
   echo "ascent_${n}_rms_mm: $rms"
   ladder+="$s $(echo "${solve[$n]}" | median) $rms $(echo "${cpu[$n]}" | median)"$'\n'
 done
-# Column $1 of the ladder (seconds per frame, or solve seconds) where it first reaches Ceres' RMS,
-# interpolated in RMS.
+# Column $1 of the ladder (seconds per frame, solve seconds, or CPU seconds per frame: columns 1,
+# 2 and 4) where it first reaches Ceres' RMS, interpolated in RMS.
 at_target() {
   printf '%s' "$ladder" | awk -v target="$ceres_rms" -v c="$1" '
     $3 <= target {
