@@ -5,7 +5,6 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
-#include <thread>
 
 #include "finecap/measure/metrics.h"
 #include "finecap/solvers/solver_trace.h"
@@ -428,10 +427,7 @@ std::string ReferenceColorRecipe(const SequenceOptions& options) {
 
 SolverOptions SolverOptionsBesideWorkAhead(const SolverOptions& configured) {
   SolverOptions options = configured;
-  const int threads = configured.num_threads > 0
-                          ? configured.num_threads
-                          : static_cast<int>(std::thread::hardware_concurrency());
-  options.num_threads = std::max(1, threads - 1);
+  options.num_threads = std::max(1, configured.Threads() - 1);
   return options;
 }
 

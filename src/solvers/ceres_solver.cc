@@ -1,6 +1,5 @@
 // The least-squares form of the energy as a Ceres problem with hand-written Jacobians.
 #include <memory>
-#include <thread>
 
 #include <ceres/ceres.h>
 
@@ -38,9 +37,7 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
   ceres::Solver::Options ceres_options;
   ceres_options.max_num_iterations = options.max_iterations;
   ceres_options.function_tolerance = 0.0;  // StopOnSmallDecrease instead.
-  ceres_options.num_threads = options.num_threads > 0
-                                  ? options.num_threads
-                                  : static_cast<int>(std::thread::hardware_concurrency());
+  ceres_options.num_threads = options.Threads();
   ceres_options.trust_region_strategy_type =
       options.trust_region == TrustRegionType::kDogleg ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
   if (options.linear_solver == LinearSolverType::kCgnr) {

@@ -1,7 +1,9 @@
 #include "finecap/solvers/solver.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "finecap/util/error.h"
@@ -35,6 +37,11 @@ void SolverSummary::AddWork(const SolverSummary& more) {
   seconds_evaluation += more.seconds_evaluation;
   seconds_linear_solver += more.seconds_linear_solver;
   seconds_similarity += more.seconds_similarity;
+}
+
+int SolverOptions::Threads() const {
+  if (num_threads > 0) return num_threads;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
 }
 
 SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k) {

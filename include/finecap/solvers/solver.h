@@ -56,6 +56,8 @@ struct SolverOptions {
   double function_tolerance = 1e-3;
   // Threads of Ceres' evaluation and linear algebra; 0 = all cores.
   int num_threads = 0;
+  // num_threads, with 0 resolved to the machine's cores (at least one).
+  int Threads() const;
 
   // Ceres only: trust-region strategy.
   TrustRegionType trust_region = TrustRegionType::kLevenbergMarquardt;
