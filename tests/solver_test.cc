@@ -102,48 +102,73 @@ TEST(CeresCostTest, SmoothnessBlocksPassTheGradientChecker) {
   EXPECT_TRUE(CheckGradient(prior_only, {0.004}, &error)) << error;
 }
 
-// A surface Gaussian's merged block (its similarity block of one parameter, a prior and three
-// neighbours, one fixed at 0): its gradient J^T r, with the secant's model, against central
-// differences of its cost 1/2 |r|^2, the similarity prepared at each point. The similarity rows
-// are the reduced ones, whose Jacobian is not their derivative (ReducedSimilarityBlockCost), so
-// the gradient is what is checked; the smoothness rows match SmoothnessBlockCost's, and the
-// similarity rows are zero in the neighbours' columns.
+// A surface Gaussian's merged block (its row of GaussianModelRows, with a prior, and three
+// neighbours, one fixed at 0) and the remainder: their gradient J^T r, with the secant's model,
+// against central differences of the cost 1/2 (|r|^2 + p k_s^2) + the smoothness terms, the
+// similarity prepared at each point; the cost with Jacobians (the row and the remainder) equals
+// the cost alone. The row is the reduced one, whose Jacobian is not its derivative
+// (GaussianModelRows), so the gradient is what is checked; the smoothness rows match
+// SmoothnessBlockCost's without a prior, and the row is zero in the neighbours' columns.
 TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
   const auto [similarity, overlap] = GetParam();
   CostScene scene(similarity, overlap);
   SimilarityTerm& term = scene.energy.similarity();
   Eigen::VectorXd point = scene.k;
   double seconds = 0.0;
-  SharedEvaluationCallback callback(&term, &point, &seconds);
   const std::vector<SmoothnessBlockCost::Neighbour> neighbours = {{1, 3.5}, {-1, 1.5}, {2, 2.0}};
-  const SmoothnessBlockCost smoothness(0.7, neighbours, 2);
+  const SmoothnessBlockCost smoothness(0.0, neighbours, 2);
+  constexpr double kPrior = 0.49;
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
   int checked = 0;
   for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 20)) {
     if (term.residual_blocks()[b].parameters.size() != 1) continue;
     const int s = term.residual_blocks()[b].parameters[0];
-    const SurfaceGaussianCost cost(term, b, true, 0.7, neighbours.data(),
+    GaussianModelRows rows(term, true);
+    const int row = rows.Add(s, b, kPrior);
+    const RemainderCost remainder(rows);
+    SharedEvaluationCallback callback(&term, &point, &seconds);
+    callback.PrepareRowsToo(&rows);
+    const SurfaceGaussianCost cost(rows, row, neighbours.data(),
                                    static_cast<int>(neighbours.size()), 2);
-    ASSERT_EQ(cost.num_residuals(), 2 + smoothness.num_residuals());
+    ASSERT_EQ(cost.num_residuals(), 1 + smoothness.num_residuals());
     ASSERT_EQ(cost.parameter_block_sizes().size(), 3u);
     const int m = cost.num_residuals();
     std::vector<double> values = {scene.k[s], 0.0011, -0.0023};
     std::vector<const double*> parameters;
     for (const double& value : values) parameters.push_back(&value);
-    // 1/2 |r|^2 at `values`, the similarity prepared at k with k_s = values[0].
-    auto half_squared_norm = [&]() {
+    // Moves the point to `values`: the similarity prepared at k with k_s = values[0].
+    auto move = [&]() {
       point = scene.k;
       point[s] = values[0];
       callback.PrepareForEvaluation(false, true);
+    };
+    // 1/2 |r|^2 at `values`, the cost alone, as Ceres evaluates a step's candidate.
+    auto half_squared_norm = [&]() {
+      move();
       Eigen::VectorXd r(m);
+      double rest = 1.0;
       EXPECT_TRUE(cost.Evaluate(parameters.data(), r.data(), nullptr));
+      EXPECT_TRUE(remainder.Evaluate(parameters.data(), &rest, nullptr));
+      EXPECT_EQ(rest, 0.0);
       return 0.5 * r.squaredNorm();
     };
-    half_squared_norm();
+    // Two points with Jacobians, so that the secant models the curvature at the second.
+    values[0] += 0.0002;
+    move();
+    callback.PrepareForEvaluation(true, false);
+    values[0] -= 0.0002;
+    const double cost_alone = half_squared_norm();
+    callback.PrepareForEvaluation(true, false);
     Eigen::VectorXd r(m);
     std::vector<Eigen::VectorXd> columns(3, Eigen::VectorXd::Constant(m, std::nan("")));
     std::vector<double*> jacobians = {columns[0].data(), columns[1].data(), columns[2].data()};
     ASSERT_TRUE(cost.Evaluate(parameters.data(), r.data(), jacobians.data()));
+    double rest = 0.0, rest_jacobian = std::nan("");
+    double* rest_jacobians[] = {&rest_jacobian};
+    ASSERT_TRUE(remainder.Evaluate(parameters.data(), &rest, rest_jacobians));
+    EXPECT_EQ(rest_jacobian, 0.0);
+    EXPECT_NEAR(0.5 * (r.squaredNorm() + rest * rest), cost_alone, 1e-12 * (1.0 + cost_alone))
+        << "block " << b;
 
     Eigen::VectorXd smoothness_r(smoothness.num_residuals());
     std::vector<Eigen::VectorXd> smoothness_columns(3, Eigen::VectorXd(smoothness_r.size()));
@@ -155,9 +180,17 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
     for (int p = 0; p < 3; ++p) {
       EXPECT_EQ(columns[p].tail(smoothness_r.size()), smoothness_columns[p]) << "block " << b;
       if (p > 0) {
-        EXPECT_EQ(columns[p].head(2), Eigen::Vector2d::Zero()) << "block " << b;
+        EXPECT_EQ(columns[p][0], 0.0) << "block " << b;
       }
     }
+    // The row's curvature is the similarity's (the secant's, within its bounds) plus the prior's.
+    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    EXPECT_GE(columns[0][0] * columns[0][0],
+              BlockCurvature::kMinSecantFactor * summary.curvature + kPrior - 1e-12)
+        << "block " << b;
+    EXPECT_LE(columns[0][0] * columns[0][0],
+              BlockCurvature::kMaxSecantFactor * summary.curvature + kPrior + 1e-12)
+        << "block " << b;
 
     constexpr double kStep = 1e-7;  // Metres; k is a few millimetres.
     for (int p = 0; p < 3; ++p) {
@@ -177,6 +210,47 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
   if (similarity != "paper") {
     EXPECT_GE(checked, 10);
   }
+}
+
+// The rows of GaussianModelRows are prepared once a point, where Ceres first asks for Jacobians
+// there, and not at a point evaluated for its cost alone: a second preparation at the same point
+// would take the secant's history for a step of length zero.
+TEST(CeresCostTest, TheCallbackPreparesTheRowsOncePerPointWithJacobians) {
+  CostScene scene("consensus", "printed");
+  SimilarityTerm& term = scene.energy.similarity();
+  Eigen::VectorXd point = scene.k;
+  double seconds = 0.0;
+  GaussianModelRows rows(term, true);
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  for (int b = 0; b < num_blocks; ++b) rows.Add(term.residual_blocks()[b].parameters[0], b, 0.0);
+  ASSERT_GT(rows.size(), 10);
+  SharedEvaluationCallback callback(&term, &point, &seconds);
+  callback.PrepareRowsToo(&rows);
+  auto lengths = [&] {
+    std::vector<double> values;
+    for (int i = 0; i < rows.size(); ++i) values.push_back(rows.Length(i));
+    return values;
+  };
+  callback.PrepareForEvaluation(false, true);
+  EXPECT_EQ(lengths(), std::vector<double>(rows.size(), 0.0)) << "prepared for a cost alone";
+  callback.PrepareForEvaluation(true, false);
+  for (int i = 0; i < rows.size(); ++i) {
+    EXPECT_NEAR(rows.Length(i) * rows.Length(i), term.BlockSummaryOf(i).curvature,
+                1e-12 * (1.0 + term.BlockSummaryOf(i).curvature));
+  }
+  point.array() += 0.0003;
+  callback.PrepareForEvaluation(false, true);
+  callback.PrepareForEvaluation(true, false);
+  const std::vector<double> secant = lengths();
+  int differ = 0;
+  for (int i = 0; i < rows.size(); ++i) {
+    differ += std::abs(secant[i] * secant[i] - term.BlockSummaryOf(i).curvature) >
+              1e-6 * term.BlockSummaryOf(i).curvature;
+  }
+  EXPECT_GT(differ, 0) << "the secant's curvature is J^T J's everywhere";
+  callback.PrepareForEvaluation(true, false);
+  callback.PrepareForEvaluation(true, true);
+  EXPECT_EQ(lengths(), secant);
 }
 
 // One residual block per surface Gaussian (its similarity block of one parameter and its
@@ -206,10 +280,17 @@ TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
   int separate_residuals = 0, merged_residuals = 0;
   const int separate_blocks = count_blocks(Layout::kSeparate, &separate_residuals);
   const int merged_blocks = count_blocks(Layout::kPerGaussian, &merged_residuals);
-  EXPECT_EQ(merged_residuals, separate_residuals);
   EXPECT_LT(merged_blocks, separate_blocks);
   if (similarity != "paper") {
-    EXPECT_EQ(merged_blocks, energy.num_parameters());
+    // One block per Gaussian and the remainder; one row per Gaussian instead of the similarity's
+    // two and the prior's.
+    EXPECT_EQ(merged_blocks, energy.num_parameters() + 1);
+    int with_row = 0, with_prior = 0;
+    for (const SimilarityTerm::ResidualBlock& block : energy.similarity().residual_blocks()) {
+      ++with_row;
+      with_prior += energy.prior_curvature()[block.parameters[0]] > 0.0;
+    }
+    EXPECT_EQ(merged_residuals, separate_residuals - with_row - with_prior + 1);
   }
 
   SolverOptions options;

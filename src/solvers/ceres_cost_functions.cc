@@ -20,20 +20,29 @@ SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const E
   }
 }
 
-void SharedEvaluationCallback::PrepareForEvaluation(bool /*evaluate_jacobians*/,
+void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
                                                     bool new_evaluation_point) {
   // Each step's candidate is evaluated for its cost alone and, once the step is taken, again
   // with Jacobians at the same point (Ceres says so); a step is mostly taken, so one preparation
   // with Jacobians serves both. Comparing the point itself also catches a point Ceres evaluates
   // again without saying so.
-  if (!new_evaluation_point || (prepared_.size() == k_->size() && prepared_ == *k_)) return;
+  const bool prepared = prepared_.size() == k_->size() && prepared_ == *k_;
+  const bool prepare_rows = evaluate_jacobians && rows_ != nullptr;
+  if ((!new_evaluation_point || prepared) && !(prepare_rows && !rows_prepared_)) return;
   const internal::Stopwatch clock;
-  if (summaries_only_) {
-    term_->PrepareBlockSummaries(*k_);
-  } else {
-    term_->SimilarityTerm::PrepareBlockSummaries(*k_);
+  if (new_evaluation_point && !prepared) {
+    if (summaries_only_) {
+      term_->PrepareBlockSummaries(*k_);
+    } else {
+      term_->SimilarityTerm::PrepareBlockSummaries(*k_);
+    }
+    prepared_ = *k_;
+    rows_prepared_ = false;
   }
-  prepared_ = *k_;
+  if (prepare_rows && !rows_prepared_) {
+    rows_->Prepare(*k_);
+    rows_prepared_ = true;
+  }
   *seconds_ += clock.Seconds();
 }
 
@@ -207,34 +216,77 @@ void SmoothnessBlockCost::Rows(double prior_root, const Neighbour* neighbours, i
   }
 }
 
-SurfaceGaussianCost::SurfaceGaussianCost(const SimilarityTerm& term, int similarity_block,
-                                         bool secant, double prior_root,
+int GaussianModelRows::Add(int parameter, int block, double prior) {
+  Gaussian gaussian;
+  gaussian.parameter = parameter;
+  gaussian.block = block;
+  gaussian.prior = prior;
+  gaussians_.push_back(gaussian);
+  return size() - 1;
+}
+
+void GaussianModelRows::Prepare(const Eigen::VectorXd& k) {
+  double remainder = 0.0;
+  for (Gaussian& gaussian : gaussians_) {
+    const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(gaussian.block);
+    const double k_s = k[gaussian.parameter];
+    const double curvature = gaussian.curvature.At(k_s, summary, secant_) + gaussian.prior;
+    gaussian.length = std::sqrt(curvature);
+    gaussian.row =
+        gaussian.length > 0.0 ? (summary.gradient + gaussian.prior * k_s) / gaussian.length : 0.0;
+    // (g + p k)^2 / (h + p) <= |r|^2 + p k^2 (Cauchy-Schwarz, h >= g^2 / |r|^2): rounding may
+    // make the difference a hair negative.
+    remainder += std::max(
+        0.0, summary.squared_norm + gaussian.prior * k_s * k_s - gaussian.row * gaussian.row);
+  }
+  remainder_norm_ = std::sqrt(remainder);
+}
+
+void GaussianModelRows::ForgetHistories() {
+  for (Gaussian& gaussian : gaussians_) gaussian.curvature.Forget();
+}
+
+double GaussianModelRows::Norm(int i, double k) const {
+  const Gaussian& gaussian = gaussians_[i];
+  return std::sqrt(term_.BlockSummaryOf(gaussian.block).squared_norm + gaussian.prior * k * k);
+}
+
+SurfaceGaussianCost::SurfaceGaussianCost(const GaussianModelRows& rows, int i,
                                          const SmoothnessBlockCost::Neighbour* neighbours,
                                          int num_neighbours, int num_free)
-    : term_(term),
-      similarity_block_(similarity_block),
-      secant_(secant),
-      prior_root_(prior_root),
-      neighbours_(neighbours),
-      num_neighbours_(num_neighbours) {
-  set_num_residuals(2 + SmoothnessBlockCost::NumRows(prior_root_, num_neighbours_));
+    : rows_(rows), index_(i), neighbours_(neighbours), num_neighbours_(num_neighbours) {
+  set_num_residuals(1 + SmoothnessBlockCost::NumRows(0.0, num_neighbours_));
   mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
 bool SurfaceGaussianCost::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
   const int num_parameters = static_cast<int>(parameter_block_sizes().size());
-  const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(similarity_block_);
-  // Each parameter block's Jacobian is one column (all blocks are 1-D): the similarity's two rows
-  // first, zero but in k_s's column, then the smoothness rows.
-  ReducedOneParameterRows(summary, parameters[0][0], secant_, &curvature_, residuals, jacobians);
-  if (jacobians != nullptr) {
+  // Each parameter block's Jacobian is one column (all blocks are 1-D): the Gaussian's row first,
+  // zero but in k_s's column, then the smoothness rows.
+  if (jacobians == nullptr) {
+    residuals[0] = rows_.Norm(index_, parameters[0][0]);
+  } else {
+    residuals[0] = rows_.Row(index_);
+    if (jacobians[0] != nullptr) jacobians[0][0] = rows_.Length(index_);
     for (int p = 1; p < num_parameters; ++p) {
-      if (jacobians[p] != nullptr) std::fill_n(jacobians[p], 2, 0.0);
+      if (jacobians[p] != nullptr) jacobians[p][0] = 0.0;
     }
   }
-  SmoothnessBlockCost::Rows(prior_root_, neighbours_, num_neighbours_, num_parameters, parameters,
-                            residuals + 2, jacobians, 2);
+  SmoothnessBlockCost::Rows(0.0, neighbours_, num_neighbours_, num_parameters, parameters,
+                            residuals + 1, jacobians, 1);
+  return true;
+}
+
+RemainderCost::RemainderCost(const GaussianModelRows& rows) : rows_(rows) {
+  set_num_residuals(1);
+  mutable_parameter_block_sizes()->assign(1, 1);
+}
+
+bool RemainderCost::Evaluate(double const* const* /*parameters*/, double* residuals,
+                             double** jacobians) const {
+  residuals[0] = jacobians == nullptr ? 0.0 : rows_.RemainderNorm();
+  if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = 0.0;
   return true;
 }
 
@@ -306,6 +358,8 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
       AddSimilarityBlocks(energy.similarity(), secant, layout, k, problem);
   SmoothnessRows rows = SmoothnessRowsOfEachGaussian(energy, num_gaussians);
   neighbours_ = std::move(rows.neighbours);
+  model_rows_ = std::make_unique<GaussianModelRows>(energy.similarity(), secant);
+  const Eigen::VectorXd& prior = energy.prior_curvature();
   std::vector<double*> parameter_blocks;
   for (int s = 0; s < num_gaussians; ++s) {
     if (merged[s] < 0 && rows.empty(s)) continue;
@@ -313,8 +367,9 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
     const int num_free = static_cast<int>(parameter_blocks.size()) - 1;
     const SmoothnessBlockCost::Neighbour* neighbours = neighbours_.data() + rows.begin[s];
     if (merged[s] >= 0) {
-      surface_gaussians_.emplace_back(energy.similarity(), merged[s], secant, rows.prior_root[s],
-                                      neighbours, rows.num_neighbours(s), num_free);
+      const int row = model_rows_->Add(s, merged[s], std::max(0.0, prior[s]));
+      surface_gaussians_.emplace_back(*model_rows_, row, neighbours, rows.num_neighbours(s),
+                                      num_free);
       problem->AddResidualBlock(&surface_gaussians_.back(), nullptr, parameter_blocks);
     } else {
       smoothness_.emplace_back(rows.prior_root[s],
@@ -324,6 +379,12 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
       problem->AddResidualBlock(&smoothness_.back(), nullptr, parameter_blocks);
     }
   }
+  if (model_rows_->size() == 0) {
+    model_rows_.reset();
+    return;
+  }
+  remainder_ = std::make_unique<RemainderCost>(*model_rows_);
+  problem->AddResidualBlock(remainder_.get(), nullptr, &(*k)[0]);
 }
 
 std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& term, bool secant,
@@ -345,9 +406,9 @@ std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& t
   return merged;
 }
 
-void FrameCostFunctions::ForgetHistories() const {
+void FrameCostFunctions::ForgetHistories() {
   for (const ReducedSimilarityBlockCost& cost : similarity_) cost.ForgetHistory();
-  for (const SurfaceGaussianCost& cost : surface_gaussians_) cost.ForgetHistory();
+  if (model_rows_ != nullptr) model_rows_->ForgetHistories();
 }
 
 }  // namespace finecap

@@ -7,6 +7,7 @@
 #define FINECAP_CERES_COST_FUNCTIONS_H_
 
 #include <deque>
+#include <memory>
 #include <vector>
 
 #include <ceres/cost_function.h>
@@ -19,19 +20,27 @@
 
 namespace finecap {
 
+class GaussianModelRows;
+
 // Calls SimilarityTerm::PrepareBlockSummaries when every block of the term has one parameter
 // (ReducedSimilarityBlockCost needs no more of them), else its default implementation, which
 // prepares the residuals with Jacobians too (the paper's term mixes blocks of one parameter and
-// of several), at every evaluation point that differs from the last one prepared. `k` is the vector
-// whose entries are the problem's parameter blocks: Ceres has written the point there when it
-// calls. Time spent is added to *seconds.
+// of several), at every evaluation point that differs from the last one prepared; and, once a
+// point when Ceres asks for Jacobians there, the rows of GaussianModelRows given with
+// PrepareRowsToo. `k` is the vector whose entries are the problem's parameter blocks: Ceres has
+// written the point there when it calls. Time spent is added to *seconds.
 class SharedEvaluationCallback : public ceres::EvaluationCallback {
  public:
   SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k, double* seconds);
   void PrepareForEvaluation(bool evaluate_jacobians, bool new_evaluation_point) override;
   // Forgets the point prepared last: the term has changed since (a further pass's patch shape),
   // and its preparation at that point no longer holds.
-  void Forget() { prepared_.resize(0); }
+  void Forget() {
+    prepared_.resize(0);
+    rows_prepared_ = false;
+  }
+  // Also prepares `rows` (not owned; null for none) wherever Jacobians are evaluated.
+  void PrepareRowsToo(GaussianModelRows* rows) { rows_ = rows; }
 
  private:
   SimilarityTerm* term_;
@@ -39,6 +48,8 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
   double* seconds_;
   bool summaries_only_;
   Eigen::VectorXd prepared_;  // The point of the last preparation (empty before the first).
+  GaussianModelRows* rows_ = nullptr;
+  bool rows_prepared_ = false;  // At prepared_.
 };
 
 // Residual block `block` of the similarity, one 1-D parameter block per k_s it depends on. Its
@@ -177,43 +188,99 @@ class SmoothnessBlockCost : public ceres::CostFunction {
   std::vector<Neighbour> neighbours_;
 };
 
-// The residual blocks of one surface Gaussian s whose similarity block has k_s as its one
-// parameter, as one residual block: the two residuals of the reduced similarity block
-// (ReducedSimilarityBlockCost, with its secant history), of Jacobian in k_s's column alone, then
-// the smoothness residuals (SmoothnessBlockCost). The same residuals, cost and steps as the two
-// blocks apart (to rounding: Ceres sums them in another order), in half the residual blocks, so
-// half the per-block work of Ceres' evaluation (preparing, invalidating and checking each block)
-// and one cell fewer per Gaussian in each conjugate-gradient product, though the neighbours'
-// cells now hold the similarity rows' zeros. On synth_skirt frame 3 (one solve from k = 0,
-// alternating with the blocks apart, ten times each, medians) Ceres' evaluation time fell by
-// 10-21 % and the solve's CPU time by 7-14 %; the linear solver's time stayed level.
+// The model rows of every surface Gaussian s whose similarity block has k_s as its one parameter,
+// with its prior folded in, prepared once a point for all of them. The reduced similarity rows
+// (ReducedOneParameterRows, with the secant's curvature h) and the prior's row sqrt(p_s) k_s
+// together are the cost 1/2 (|r|^2 + p_s k_s^2), gradient g + p_s k_s and Gauss-Newton curvature
+// h + p_s of a Gaussian; one row holds them: (g + p_s k_s) / sqrt(h + p_s), of Jacobian
+// sqrt(h + p_s). What of the cost no step can reduce, |r|^2 + p_s k_s^2 less that row's square,
+// is summed over all the Gaussians into one remainder (RemainderCost). The same cost, gradient
+// and J^T J, so the same linear model and steps (to rounding), with one row per Gaussian instead
+// of three: Ceres' Jacobian cells hold every row of a residual block in every one of its
+// parameter blocks' columns, so the two rows left out were zeros in each neighbour's cell, which
+// Ceres filled, checked and multiplied in every product of the conjugate gradients. On synth_skirt
+// one solve of frame 3 (BM_Solve, three alternating runs) fell from 72.6 to 66.6 ms, and 30
+// frames' CPU from 0.542 to 0.531 s a frame (medians of five alternating runs), the same steps
+// and error.
+class GaussianModelRows {
+ public:
+  GaussianModelRows(const SimilarityTerm& term, bool secant) : term_(term), secant_(secant) {}
+  // Adds surface Gaussian `parameter` (its index in k), its similarity block `block` of one
+  // parameter and its prior's curvature p_s (0 for none); returns its index among the rows.
+  int Add(int parameter, int block, double prior);
+  // Every row, its Jacobian and the remainder at k, the term's block summaries prepared there;
+  // with the secant, records each Gaussian's gradient for the next point's curvature.
+  void Prepare(const Eigen::VectorXd& k);
+  // Forgets the secant's history: gradients of a term that has changed since do not measure the
+  // curvature of the new one.
+  void ForgetHistories();
+
+  // Gaussian i's cost alone at k_s = k: sqrt(|r|^2 + p_s k^2), from the current summaries.
+  double Norm(int i, double k) const;
+  // At the point prepared last: Gaussian i's row, its Jacobian, and the remainder's residual.
+  double Row(int i) const { return gaussians_[i].row; }
+  double Length(int i) const { return gaussians_[i].length; }
+  double RemainderNorm() const { return remainder_norm_; }
+  int size() const { return static_cast<int>(gaussians_.size()); }
+
+ private:
+  struct Gaussian {
+    int parameter = -1;
+    int block = -1;
+    double prior = 0.0;
+    BlockCurvature curvature;
+    double row = 0.0, length = 0.0;
+  };
+  const SimilarityTerm& term_;
+  bool secant_;
+  std::vector<Gaussian> gaussians_;
+  double remainder_norm_ = 0.0;
+};
+
+// Gaussian i of GaussianModelRows and its smoothness residuals (SmoothnessBlockCost, without a
+// prior: the row holds it) as one residual block: its row, of Jacobian in k_s's column alone, then
+// one row per pair of neighbours. One residual block per Gaussian instead of one for its
+// similarity and one for its smoothness: half the per-block work of Ceres' evaluation (preparing,
+// invalidating and checking each block) and one cell fewer per Gaussian in each conjugate-gradient
+// product. On synth_skirt frame 3 (one solve from k = 0, alternating with the blocks apart, ten
+// times each, medians) Ceres' evaluation time fell by 10-21 % and the solve's CPU time by 7-14 %;
+// the linear solver's time stayed level.
 //
 // Parameter blocks: those of the smoothness block, k_s first.
 class SurfaceGaussianCost : public ceres::CostFunction {
  public:
-  // The similarity block as ReducedSimilarityBlockCost(term, similarity_block, secant) takes it,
-  // the smoothness residuals as SmoothnessBlockCost(prior_root, neighbours, num_free) with the
-  // `num_neighbours` neighbours from `neighbours` on, which must outlive this object.
-  SurfaceGaussianCost(const SimilarityTerm& term, int similarity_block, bool secant,
-                      double prior_root, const SmoothnessBlockCost::Neighbour* neighbours,
-                      int num_neighbours, int num_free);
+  // Row i of `rows`, the smoothness residuals as SmoothnessBlockCost(0, neighbours, num_free) with
+  // the `num_neighbours` neighbours from `neighbours` on; both must outlive this object.
+  SurfaceGaussianCost(const GaussianModelRows& rows, int i,
+                      const SmoothnessBlockCost::Neighbour* neighbours, int num_neighbours,
+                      int num_free);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
-  void ForgetHistory() const { curvature_.Forget(); }
 
  private:
-  // One cost function, not one of each kind inside it: Ceres and this object read the block's
-  // data at every evaluation, and a Gaussian's block is 112 bytes and two allocations instead of
-  // 248 and five (on synth_skirt frame 3, alone, five runs of each in turn: Ceres' evaluation
-  // 0.129 -> 0.118 s, the solve 0.202 -> 0.193 s, medians; the same steps). The neighbours live
-  // in one array for all the Gaussians (FrameCostFunctions), not one allocation each.
-  const SimilarityTerm& term_;
-  int similarity_block_;
-  bool secant_;
-  mutable BlockCurvature curvature_;  // Ceres evaluates a block from one thread at a time.
-  double prior_root_;
+  // One cost function with the block's data, not one of each kind inside it: Ceres and this
+  // object read the block's data at every evaluation, and a Gaussian's block is then a small
+  // object and two allocations instead of 248 bytes and five (on synth_skirt frame 3, alone, five
+  // runs of each in turn: Ceres' evaluation 0.129 -> 0.118 s, the solve 0.202 -> 0.193 s,
+  // medians; the same steps). The neighbours live in one array for all the Gaussians
+  // (FrameCostFunctions), not one allocation each.
+  const GaussianModelRows& rows_;
+  int index_;
   const SmoothnessBlockCost::Neighbour* neighbours_;
   int num_neighbours_;
+};
+
+// The remainder of GaussianModelRows as one residual of zero Jacobian, on one parameter block
+// (Ceres' residual blocks need one): sqrt of the sum, at a point with Jacobians; 0 at a point
+// evaluated for its cost alone, where each Gaussian's row holds its whole cost.
+class RemainderCost : public ceres::CostFunction {
+ public:
+  explicit RemainderCost(const GaussianModelRows& rows);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  const GaussianModelRows& rows_;
 };
 
 // The cost functions of one solve and the residual blocks they make. The problem does not own
@@ -223,8 +290,9 @@ class SurfaceGaussianCost : public ceres::CostFunction {
 class FrameCostFunctions {
  public:
   // How the residual blocks are laid out: one SurfaceGaussianCost per surface Gaussian whose
-  // similarity block has one parameter (the default), or every similarity block and every
-  // Gaussian's smoothness block apart (kept to check that both give the same steps).
+  // similarity block has one parameter and their RemainderCost (the default), or every
+  // similarity block and every Gaussian's smoothness block apart (kept to check that both give
+  // the same steps).
   enum class Layout { kPerGaussian, kSeparate };
 
   // Adds the least-squares form of `energy` to `problem`, over the parameter blocks &(*k)[s],
@@ -233,7 +301,10 @@ class FrameCostFunctions {
   void AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout, Eigen::VectorXd* k,
                          ceres::Problem* problem);
   // Forgets every similarity block's secant history (ReducedSimilarityBlockCost::ForgetHistory).
-  void ForgetHistories() const;
+  void ForgetHistories();
+  // The rows of the Gaussians of SurfaceGaussianCost blocks, for the callback to prepare; null
+  // when there are none.
+  GaussianModelRows* model_rows() { return model_rows_.get(); }
 
  private:
   // Adds the similarity blocks that stand alone; returns, for each surface Gaussian, the block
@@ -247,6 +318,8 @@ class FrameCostFunctions {
   std::deque<ReducedSimilarityBlockCost> similarity_;
   std::deque<SmoothnessBlockCost> smoothness_;
   std::deque<SurfaceGaussianCost> surface_gaussians_;
+  std::unique_ptr<GaussianModelRows> model_rows_;
+  std::unique_ptr<RemainderCost> remainder_;
 };
 
 }  // namespace finecap

@@ -75,6 +75,7 @@ CeresFrameProblem::CeresFrameProblem(FrameEnergy* energy, bool secant,
   // ~11 ms that building and destroying a synth_skirt problem takes.
   problem_ = std::make_unique<ceres::Problem>(problem_options);
   cost_functions_.AddResidualBlocks(*energy, secant, layout, k, problem_.get());
+  shared_.PrepareRowsToo(cost_functions_.model_rows());
 }
 
 void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clock,
