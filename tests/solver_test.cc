@@ -361,6 +361,52 @@ TEST(FrameSolverTest, PassesOnOneProblemTakeTheStepsOfFreshProblems) {
   consensus->SetPatchShape(flat);
 }
 
+// A workspace carries Ceres' problem from one frame's energy to the next of the same structure
+// (other image Gaussians, so other similarity values and blocks): each frame takes the steps a
+// problem of its own takes, reading its own energy, not the last one's. An energy of another
+// structure (no regulariser) gets a problem of its own, and takes its steps too.
+TEST(FrameSolverTest, FramesInOneWorkspaceTakeTheStepsOfProblemsOfTheirOwn) {
+  EnergyOptions energy_options = Options("consensus", "printed");
+  energy_options.w_prior = 1e-4;
+  EnergyOptions without_regularizer = energy_options;
+  without_regularizer.w_reg = 0.0;
+  std::vector<EnergyScene> scenes;
+  scenes.push_back(MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31));
+  scenes.push_back(MakeEnergyScene({0.0, 0.8, 1.3}, 3, 47));
+  std::vector<std::unique_ptr<FrameEnergy>> frames;
+  for (const EnergyOptions& options : {energy_options, energy_options, without_regularizer}) {
+    const EnergyScene& scene = scenes[frames.size() % 2];
+    frames.push_back(
+        std::make_unique<FrameEnergy>(scene.surface, scene.cameras, scene.neighbourhoods, options));
+  }
+  ASSERT_EQ(frames[0]->num_parameters(), frames[1]->num_parameters());
+  Eigen::VectorXd start(frames[0]->num_parameters());
+  for (int s = 0; s < start.size(); ++s) start[s] = 0.002 * std::sin(1.7 * s);
+  SolverOptions options;
+  options.max_iterations = 5;
+  options.function_tolerance = 1e-12;
+  options.num_threads = 2;
+
+  SolverWorkspace workspace;
+  std::vector<Eigen::VectorXd> solved;
+  const std::vector<int> built = {1, 1, 2};
+  for (size_t f = 0; f < frames.size(); ++f) {
+    Eigen::VectorXd own = start, shared = start;
+    const SolverSummary alone = Solve(frames[f].get(), options, &own);
+    const SolverSummary taken_over =
+        FrameSolver(frames[f].get(), options, &workspace).Solve(&shared);
+    EXPECT_EQ(workspace.problems_built(), built[f]) << "frame " << f;
+    ASSERT_GT((own - start).norm(), 1e-3 * start.norm()) << "frame " << f << " did not move";
+    EXPECT_EQ(taken_over.iterations, alone.iterations) << "frame " << f;
+    EXPECT_NEAR(taken_over.ls_cost_end, alone.ls_cost_end, 1e-12 * alone.ls_cost_end)
+        << "frame " << f;
+    EXPECT_LE((shared - own).norm(), 1e-12 * own.norm()) << "frame " << f;
+    solved.push_back(own);
+  }
+  // The frames differ: a problem reading the last frame's energy would not take their steps.
+  EXPECT_GT((solved[1] - solved[0]).norm(), 1e-3 * solved[0].norm());
+}
+
 // A frame's passes and levels add up: every count and time of the work, and nothing of where the
 // solve started or ended.
 TEST(SolverSummaryTest, AddWorkSumsCountsAndTimes) {

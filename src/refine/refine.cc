@@ -194,9 +194,9 @@ namespace {
 // found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
 // so that `worse` compares the frame by the energy it ended with.
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
-                               Eigen::VectorXd* k) {
+                               Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
   const Eigen::VectorXd start = *k;
-  FrameSolver solver(energy, options.solver);  // One Ceres problem for all the passes.
+  FrameSolver solver(energy, options.solver, workspace);  // One Ceres problem for all the passes.
   SolverSummary summary = solver.Solve(k);
   auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
   if (consensus == nullptr) return summary;
@@ -260,11 +260,12 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
 }
 
 // RefineFrame, starting each level that does not continue from a coarser one at
-// `starting_point`; the configured level is `ahead` when that is not empty.
+// `starting_point`; the configured level is `ahead` when that is not empty, and is solved in
+// `workspace` (the coarser levels, whose problems differ from it, in their own).
 FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
-                                  const StartingPointFunction& starting_point,
-                                  PreparedFrame ahead) {
+                                  const StartingPointFunction& starting_point, PreparedFrame ahead,
+                                  SolverWorkspace* workspace) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   FrameResult result;
@@ -286,7 +287,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   // The frame got worse or better against where it started, before any level moved it.
   const Eigen::VectorXd initial = starting_point(&frame);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
-  result.summary = SolveFrameEnergy(&energy, options, &k);
+  result.summary = SolveFrameEnergy(&energy, options, &k, workspace);
   if (coarse_k.size() > 0) {
     EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
                           &result.summary.ls_cost_start);
@@ -341,16 +342,18 @@ Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,
 
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start, PreparedFrame ahead) {
+                        const Eigen::VectorXd* warm_start, PreparedFrame ahead,
+                        SolverWorkspace* workspace) {
   return RefineFrameStartingAt(
       model, colors, input, options,
       [&](PreparedFrame* frame) { return StartingPoint(frame, options.sweep, warm_start); },
-      std::move(ahead));
+      std::move(ahead), workspace);
 }
 
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
                             const FrameInput& input, const RefineOptions& options,
-                            const Eigen::VectorXd& start, PreparedFrame ahead) {
+                            const Eigen::VectorXd& start, PreparedFrame ahead,
+                            SolverWorkspace* workspace) {
   Require(start.size() == model.num_fine_vertices(), "refine",
           "a start of " + std::to_string(start.size()) + " displacements for " +
               std::to_string(model.num_fine_vertices()) + " fine vertices");
@@ -364,7 +367,7 @@ FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& c
         }
         return k;
       },
-      std::move(ahead));
+      std::move(ahead), workspace);
 }
 
 }  // namespace finecap

@@ -350,10 +350,11 @@ class SequenceRun {
     if (prepare_ahead_ && reader_.ReadsAhead()) {
       refine.solver = SolverOptionsBesideWorkAhead(refine.solver);
     }
-    FrameResult result =
-        warm_start.size() > 0
-            ? RefineFrameFrom(model_, colors, input, refine, warm_start, std::move(read.prepared))
-            : RefineFrame(model_, colors, input, refine, nullptr, std::move(read.prepared));
+    FrameResult result = warm_start.size() > 0
+                             ? RefineFrameFrom(model_, colors, input, refine, warm_start,
+                                               std::move(read.prepared), &solver_workspace_)
+                             : RefineFrame(model_, colors, input, refine, nullptr,
+                                           std::move(read.prepared), &solver_workspace_);
     if (result.num_surface_gaussians == 0) observer_->NothingToRefine(name);
 
     FrameStats stats = MakeFrameStats(name, options_.refine, result);
@@ -384,6 +385,8 @@ class SequenceRun {
   FrameReadAhead reader_;
   const ReferenceColors reference_colors_;
   const Regions regions_;
+  // The solver's problem, taken over by each frame from the one before (SolverWorkspace).
+  SolverWorkspace solver_workspace_;
 };
 
 }  // namespace

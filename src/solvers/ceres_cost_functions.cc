@@ -46,6 +46,15 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
   *seconds_ += clock.Seconds();
 }
 
+void SharedEvaluationCallback::Rebind(SimilarityTerm* term) {
+  term_ = term;
+  summaries_only_ = true;
+  for (const SimilarityTerm::ResidualBlock& block : term->residual_blocks()) {
+    if (block.parameters.size() != 1) summaries_only_ = false;
+  }
+  Forget();
+}
+
 SimilarityBlockCost::SimilarityBlockCost(const SimilarityTerm& term, int block)
     : term_(term), block_(block) {
   const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
@@ -228,7 +237,7 @@ int GaussianModelRows::Add(int parameter, int block, double prior) {
 void GaussianModelRows::Prepare(const Eigen::VectorXd& k) {
   double remainder = 0.0;
   for (Gaussian& gaussian : gaussians_) {
-    const SimilarityTerm::BlockSummary& summary = term_.BlockSummaryOf(gaussian.block);
+    const SimilarityTerm::BlockSummary& summary = SummaryOf(gaussian);
     const double k_s = k[gaussian.parameter];
     const double curvature = gaussian.curvature.At(k_s, summary, secant_) + gaussian.prior;
     gaussian.length = std::sqrt(curvature);
@@ -248,7 +257,7 @@ void GaussianModelRows::ForgetHistories() {
 
 double GaussianModelRows::Norm(int i, double k) const {
   const Gaussian& gaussian = gaussians_[i];
-  return std::sqrt(term_.BlockSummaryOf(gaussian.block).squared_norm + gaussian.prior * k * k);
+  return std::sqrt(SummaryOf(gaussian).squared_norm + gaussian.prior * k * k);
 }
 
 SurfaceGaussianCost::SurfaceGaussianCost(const GaussianModelRows& rows, int i,
@@ -358,15 +367,20 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
       AddSimilarityBlocks(energy.similarity(), secant, layout, k, problem);
   SmoothnessRows rows = SmoothnessRowsOfEachGaussian(energy, num_gaussians);
   neighbours_ = std::move(rows.neighbours);
+  const bool per_gaussian = layout == Layout::kPerGaussian;
+  rebindable_ = per_gaussian && similarity_.empty() && num_gaussians > 0;
+  k_max_ = k_max;
+  neighbour_begin_ = rows.begin;
+  neighbour_other_ = rows.other;
   model_rows_ = std::make_unique<GaussianModelRows>(energy.similarity(), secant);
   const Eigen::VectorXd& prior = energy.prior_curvature();
   std::vector<double*> parameter_blocks;
   for (int s = 0; s < num_gaussians; ++s) {
-    if (merged[s] < 0 && rows.empty(s)) continue;
+    if (!per_gaussian && rows.empty(s)) continue;
     rows.ParameterBlocks(s, k, &parameter_blocks);
     const int num_free = static_cast<int>(parameter_blocks.size()) - 1;
     const SmoothnessBlockCost::Neighbour* neighbours = neighbours_.data() + rows.begin[s];
-    if (merged[s] >= 0) {
+    if (per_gaussian) {
       const int row = model_rows_->Add(s, merged[s], std::max(0.0, prior[s]));
       surface_gaussians_.emplace_back(*model_rows_, row, neighbours, rows.num_neighbours(s),
                                       num_free);
@@ -385,6 +399,29 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
   }
   remainder_ = std::make_unique<RemainderCost>(*model_rows_);
   problem->AddResidualBlock(remainder_.get(), nullptr, &(*k)[0]);
+}
+
+bool FrameCostFunctions::Rebind(const FrameEnergy& energy) {
+  const SimilarityTerm& term = energy.similarity();
+  const int num_gaussians = model_rows_ != nullptr ? model_rows_->size() : 0;
+  if (!rebindable_ || energy.num_parameters() != num_gaussians ||
+      energy.options().k_max != k_max_) {
+    return false;
+  }
+  std::vector<int> block_of(num_gaussians, -1);
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+    const std::vector<int>& parameters = term.residual_blocks()[b].parameters;
+    if (parameters.size() != 1 || block_of[parameters[0]] >= 0) return false;
+    block_of[parameters[0]] = b;
+  }
+  SmoothnessRows rows = SmoothnessRowsOfEachGaussian(energy, num_gaussians);
+  if (rows.begin != neighbour_begin_ || rows.other != neighbour_other_) return false;
+  // In place: every SurfaceGaussianCost holds its neighbours' address.
+  std::copy(rows.neighbours.begin(), rows.neighbours.end(), neighbours_.begin());
+  model_rows_->Rebind(term);
+  const Eigen::VectorXd& prior = energy.prior_curvature();
+  for (int s = 0; s < num_gaussians; ++s) model_rows_->Set(s, block_of[s], std::max(0.0, prior[s]));
+  return true;
 }
 
 std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& term, bool secant,

@@ -41,6 +41,8 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
   }
   // Also prepares `rows` (not owned; null for none) wherever Jacobians are evaluated.
   void PrepareRowsToo(GaussianModelRows* rows) { rows_ = rows; }
+  // Prepares `term` from now on instead, forgetting the point prepared last.
+  void Rebind(SimilarityTerm* term);
 
  private:
   SimilarityTerm* term_;
@@ -204,10 +206,17 @@ class SmoothnessBlockCost : public ceres::CostFunction {
 // and error.
 class GaussianModelRows {
  public:
-  GaussianModelRows(const SimilarityTerm& term, bool secant) : term_(term), secant_(secant) {}
+  GaussianModelRows(const SimilarityTerm& term, bool secant) : term_(&term), secant_(secant) {}
   // Adds surface Gaussian `parameter` (its index in k), its similarity block `block` of one
-  // parameter and its prior's curvature p_s (0 for none); returns its index among the rows.
+  // parameter (-1 for none: its row is then its prior's alone) and its prior's curvature p_s (0
+  // for none); returns its index among the rows.
   int Add(int parameter, int block, double prior);
+  // Reads `term` from now on; Gaussian i's block and prior are then Set anew.
+  void Rebind(const SimilarityTerm& term) { term_ = &term; }
+  void Set(int i, int block, double prior) {
+    gaussians_[i].block = block;
+    gaussians_[i].prior = prior;
+  }
   // Every row, its Jacobian and the remainder at k, the term's block summaries prepared there;
   // with the secant, records each Gaussian's gradient for the next point's curvature.
   void Prepare(const Eigen::VectorXd& k);
@@ -231,7 +240,13 @@ class GaussianModelRows {
     BlockCurvature curvature;
     double row = 0.0, length = 0.0;
   };
-  const SimilarityTerm& term_;
+  // The summary of Gaussian's block, zero where it has none.
+  const SimilarityTerm::BlockSummary& SummaryOf(const Gaussian& gaussian) const {
+    static const SimilarityTerm::BlockSummary kNone;
+    return gaussian.block >= 0 ? term_->BlockSummaryOf(gaussian.block) : kNone;
+  }
+
+  const SimilarityTerm* term_;
   bool secant_;
   std::vector<Gaussian> gaussians_;
   double remainder_norm_ = 0.0;
@@ -297,9 +312,18 @@ class FrameCostFunctions {
 
   // Adds the least-squares form of `energy` to `problem`, over the parameter blocks &(*k)[s],
   // each bounded by k_max. `secant`: CurvatureModel::kSecant. Once per object: its cost functions
-  // read arrays that it holds.
+  // read arrays that it holds. With kPerGaussian every surface Gaussian has a SurfaceGaussianCost,
+  // with or without a similarity block, so that the blocks depend on the similarity's structure
+  // only through its blocks of several parameters.
   void AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout, Eigen::VectorXd* k,
                          ceres::Problem* problem);
+  // Points the cost functions at `energy` instead of the one they were added for, when its
+  // least-squares form has the same residual blocks: kPerGaussian, no similarity block of
+  // several parameters in either, as many surface Gaussians, the same pairs of neighbours and
+  // the same k_max. Returns false, changing nothing, when it has not. The similarity's residual
+  // values, the priors and the pairs' weights may all differ: a sequence's frames reuse one
+  // problem.
+  bool Rebind(const FrameEnergy& energy);
   // Forgets every similarity block's secant history (ReducedSimilarityBlockCost::ForgetHistory).
   void ForgetHistories();
   // The rows of the Gaussians of SurfaceGaussianCost blocks, for the callback to prepare; null
@@ -312,6 +336,10 @@ class FrameCostFunctions {
   std::vector<int> AddSimilarityBlocks(const SimilarityTerm& term, bool secant, Layout layout,
                                        Eigen::VectorXd* k, ceres::Problem* problem);
 
+  // Whether Rebind can take an energy: the layout and what its residual blocks were made of.
+  bool rebindable_ = false;
+  double k_max_ = 0.0;
+  std::vector<int> neighbour_begin_, neighbour_other_;
   // Every SurfaceGaussianCost's neighbours, Gaussian after Gaussian.
   std::vector<SmoothnessBlockCost::Neighbour> neighbours_;
   // Elements of a deque stay where they are as it grows: the problem holds their addresses.

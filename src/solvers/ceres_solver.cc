@@ -3,6 +3,7 @@
 
 #include <ceres/ceres.h>
 
+#include "finecap/util/error.h"
 #include "solvers/ceres_cost_functions.h"
 #include "solvers/solvers_internal.h"
 
@@ -66,20 +67,30 @@ ceres::Solver::Options MakeCeresOptions(const SolverOptions& options) {
 }  // namespace
 
 CeresFrameProblem::CeresFrameProblem(FrameEnergy* energy, bool secant,
-                                     FrameCostFunctions::Layout layout, Eigen::VectorXd* k)
-    : k_(k), shared_(&energy->similarity(), k, &seconds_shared_) {
+                                     FrameCostFunctions::Layout layout)
+    : secant_(secant),
+      state_(Eigen::VectorXd::Zero(energy->num_parameters())),
+      shared_(&energy->similarity(), &state_, &seconds_shared_) {
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &shared_;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Ceres' checks as the problem is built stay on: disable_all_safety_checks saved ~0.1 of the
   // ~11 ms that building and destroying a synth_skirt problem takes.
   problem_ = std::make_unique<ceres::Problem>(problem_options);
-  cost_functions_.AddResidualBlocks(*energy, secant, layout, k, problem_.get());
+  cost_functions_.AddResidualBlocks(*energy, secant, layout, &state_, problem_.get());
   shared_.PrepareRowsToo(cost_functions_.model_rows());
 }
 
+bool CeresFrameProblem::Rebind(FrameEnergy* energy, bool secant) {
+  if (secant != secant_ || !cost_functions_.Rebind(*energy)) return false;
+  shared_.Rebind(&energy->similarity());
+  return true;
+}
+
 void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clock,
-                              SolverSummary* summary) {
+                              Eigen::VectorXd* k, SolverSummary* summary) {
+  Require(k->size() == state_.size(), "solver", "k does not fit the Ceres problem");
+  state_ = *k;
   shared_.Forget();
   cost_functions_.ForgetHistories();
   ceres::Solver::Options ceres_options = MakeCeresOptions(options);
@@ -106,13 +117,14 @@ void CeresFrameProblem::Solve(const SolverOptions& options, const Stopwatch& clo
                                 ceres_summary.jacobian_evaluation_time_in_seconds;
   summary->seconds_linear_solver = ceres_summary.linear_solver_time_in_seconds;
   summary->seconds_similarity = seconds_shared_ - seconds_shared_before;
+  *k = state_;
 }
 
 void SolveWithCeres(FrameEnergy* energy, const SolverOptions& options, Eigen::VectorXd* k,
                     SolverSummary* summary, FrameCostFunctions::Layout layout) {
   const Stopwatch clock;
-  CeresFrameProblem(energy, options.curvature == CurvatureModel::kSecant, layout, k)
-      .Solve(options, clock, summary);
+  CeresFrameProblem(energy, options.curvature == CurvatureModel::kSecant, layout)
+      .Solve(options, clock, k, summary);
 }
 
 }  // namespace internal

@@ -48,8 +48,14 @@ SolverSummary Solve(FrameEnergy* energy, const SolverOptions& options, Eigen::Ve
   return FrameSolver(energy, options).Solve(k);
 }
 
-FrameSolver::FrameSolver(FrameEnergy* energy, const SolverOptions& options)
-    : energy_(energy), options_(options) {
+SolverWorkspace::SolverWorkspace() = default;
+SolverWorkspace::~SolverWorkspace() = default;
+
+FrameSolver::FrameSolver(FrameEnergy* energy, const SolverOptions& options,
+                         SolverWorkspace* workspace)
+    : energy_(energy),
+      options_(options),
+      workspace_(workspace != nullptr ? workspace : &own_workspace_) {
   options_.Check();
 }
 
@@ -57,12 +63,15 @@ FrameSolver::~FrameSolver() = default;
 
 void FrameSolver::SolveWithCeres(Eigen::VectorXd* k, SolverSummary* summary) {
   const internal::Stopwatch clock;
-  if (ceres_ == nullptr || ceres_->k() != k) {
-    ceres_ = std::make_unique<internal::CeresFrameProblem>(
-        energy_, options_.curvature == CurvatureModel::kSecant,
-        FrameCostFunctions::Layout::kPerGaussian, k);
+  const bool secant = options_.curvature == CurvatureModel::kSecant;
+  std::unique_ptr<internal::CeresFrameProblem>& problem = workspace_->ceres_;
+  if (problem == nullptr || !problem->Rebind(energy_, secant)) {
+    problem.reset();  // Freed before the next is built: one in memory at a time.
+    problem = std::make_unique<internal::CeresFrameProblem>(
+        energy_, secant, FrameCostFunctions::Layout::kPerGaussian);
+    ++workspace_->problems_built_;
   }
-  ceres_->Solve(options_, clock, summary);
+  problem->Solve(options_, clock, k, summary);
 }
 
 SolverSummary FrameSolver::Solve(Eigen::VectorXd* k) {

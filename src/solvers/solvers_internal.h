@@ -52,25 +52,29 @@ class TraceRecorder : public ceres::IterationCallback {
 };
 
 // The least-squares form of a frame's energy as a Ceres problem, built once and solved as often
-// as asked over the same k: the cost functions, residual blocks and parameter blocks (on
-// synth_skirt ~10-15 ms to build and free, on the solving thread alone) then serve every pass of
-// the frame. Between two solves the energy's values may change (a pass's patch shape), not its
-// structure (its residual blocks, regulariser, prior and k_max): each solve forgets the point
-// prepared last and the secant histories, so that it takes the steps a problem built afresh
-// would.
+// as asked: the cost functions, residual blocks and parameter blocks (on synth_skirt ~10 ms to
+// build and free, on the solving thread alone) then serve every pass of the frame and, through
+// Rebind, the frames after it while their problems have the same structure. Between two solves
+// the energy's values may change (a pass's patch shape, another frame's images), not its
+// structure: each solve forgets the point prepared last and the secant histories, so that it
+// takes the steps a problem built afresh would. The parameter blocks are the entries of a vector
+// of its own, into which each solve copies its start.
 class CeresFrameProblem {
  public:
-  // The problem over the parameter blocks &(*k)[s]; `secant`: CurvatureModel::kSecant.
-  CeresFrameProblem(FrameEnergy* energy, bool secant, FrameCostFunctions::Layout layout,
-                    Eigen::VectorXd* k);
+  // The problem of `energy`; `secant`: CurvatureModel::kSecant.
+  CeresFrameProblem(FrameEnergy* energy, bool secant, FrameCostFunctions::Layout layout);
+  // Takes `energy` from now on, when its problem has the structure of this one
+  // (FrameCostFunctions::Rebind) and the same curvature model; returns false, changing nothing,
+  // when not.
+  bool Rebind(FrameEnergy* energy, bool secant);
   // Solves from *k, in place. `clock` started with the solve (before the problem was built, if it
   // was built for it); the summary's times and trace are taken against it.
-  void Solve(const SolverOptions& options, const Stopwatch& clock, SolverSummary* summary);
-  // The vector whose entries are the parameter blocks.
-  const Eigen::VectorXd* k() const { return k_; }
+  void Solve(const SolverOptions& options, const Stopwatch& clock, Eigen::VectorXd* k,
+             SolverSummary* summary);
 
  private:
-  Eigen::VectorXd* k_;
+  bool secant_;
+  Eigen::VectorXd state_;  // The parameter blocks.
   double seconds_shared_ = 0.0;
   SharedEvaluationCallback shared_;
   FrameCostFunctions cost_functions_;  // Outlive the problem, which does not own them.

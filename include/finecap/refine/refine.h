@@ -254,19 +254,23 @@ Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,
 // Refines one frame, through the coarse-to-fine levels when configured. `warm_start` (may be
 // null) is a previous frame's k_solved. `ahead`, when not empty, is PrepareFrameAhead's
 // preparation of this very frame (input, colours and options), used instead of preparing again.
+// `workspace` (may be null) carries the solver's problem from frame to frame (SolverWorkspace):
+// a sequence hands every frame the same one.
 FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& colors,
                         const FrameInput& input, const RefineOptions& options,
-                        const Eigen::VectorXd* warm_start = nullptr, PreparedFrame ahead = {});
+                        const Eigen::VectorXd* warm_start = nullptr, PreparedFrame ahead = {},
+                        SolverWorkspace* workspace = nullptr);
 
 // RefineFrame, starting from `start`: one displacement per fine vertex, metres, as solved
 // (before bias compensation); NaN where there is none, and those vertices start where RefineFrame
 // would start them (at zero, or where the plane sweep puts them). This is how a frame is seeded
 // from another frame's saved result: a fine vertex keeps its id over the sequence, while the
 // surface Gaussians of two frames may differ. Throws Error when `start` has not one entry per
-// fine vertex. `ahead` as for RefineFrame.
+// fine vertex. `ahead` and `workspace` as for RefineFrame.
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
                             const FrameInput& input, const RefineOptions& options,
-                            const Eigen::VectorXd& start, PreparedFrame ahead = {});
+                            const Eigen::VectorXd& start, PreparedFrame ahead = {},
+                            SolverWorkspace* workspace = nullptr);
 
 }  // namespace finecap
 

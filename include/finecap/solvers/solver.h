@@ -122,23 +122,47 @@ namespace internal {
 class CeresFrameProblem;
 }  // namespace internal
 
+// What the Ceres solver keeps from one frame to the next: its problem (cost functions, residual
+// and parameter blocks), which the next frame's energy takes over when its least-squares form has
+// the same structure (the same surface Gaussians, pairs of neighbours, k_max and curvature model,
+// and no similarity block of several parameters), as the frames of a sequence at one level of
+// detail have. Building and freeing the problem took ~10 ms of each synth_skirt frame, on the
+// solving thread. Hand it to one FrameSolver at a time; it holds the last problem until it is
+// destroyed.
+class SolverWorkspace {
+ public:
+  SolverWorkspace();
+  ~SolverWorkspace();
+  SolverWorkspace(const SolverWorkspace&) = delete;
+  SolverWorkspace& operator=(const SolverWorkspace&) = delete;
+
+  // How many Ceres problems have been built in it: a problem taken over is not counted again.
+  int problems_built() const { return problems_built_; }
+
+ private:
+  friend class FrameSolver;
+  std::unique_ptr<internal::CeresFrameProblem> ceres_;
+  int problems_built_ = 0;
+};
+
 // Solve, for one frame's energy solved more than once: the consensus similarity's passes, each
-// after the energy's patch shape has changed. Ceres' problem (its cost functions, residual and
-// parameter blocks) is built at the first solve and kept for the next ones over the same k, where
-// Solve would build and free it every time (~10-15 ms on synth_skirt, on the solving thread
-// alone); each solve takes the same steps as Solve. The other solvers keep nothing.
+// after the energy's patch shape has changed. Ceres' problem is built at the first solve and kept
+// in the workspace for the next ones, and for the next frame's solver given the same workspace,
+// where Solve would build and free it every time; each solve takes the same steps as Solve. The
+// other solvers keep nothing.
 //
-// Between solves the energy's values may change, not its structure: the same residual blocks,
-// regulariser, prior and k_max. `energy` must outlive the solver.
+// Between the solves of one solver the energy's values may change, not its structure: the same
+// residual blocks, regulariser, prior and k_max. `energy` and `workspace` must outlive the solver;
+// without a workspace it keeps one of its own.
 class FrameSolver {
  public:
-  FrameSolver(FrameEnergy* energy, const SolverOptions& options);
+  FrameSolver(FrameEnergy* energy, const SolverOptions& options,
+              SolverWorkspace* workspace = nullptr);
   ~FrameSolver();
   FrameSolver(const FrameSolver&) = delete;
   FrameSolver& operator=(const FrameSolver&) = delete;
 
-  // As Solve(energy, options, k). A Ceres problem built over another vector than `k` is built
-  // again over `k`.
+  // As Solve(energy, options, k).
   SolverSummary Solve(Eigen::VectorXd* k);
 
  private:
@@ -147,7 +171,8 @@ class FrameSolver {
 
   FrameEnergy* energy_;
   SolverOptions options_;
-  std::unique_ptr<internal::CeresFrameProblem> ceres_;
+  SolverWorkspace own_workspace_;
+  SolverWorkspace* workspace_;
 };
 
 // 1/2 sum of squared residuals of the least-squares form at k (similarity and regulariser).
