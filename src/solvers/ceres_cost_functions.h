@@ -198,12 +198,12 @@ class SmoothnessBlockCost : public ceres::CostFunction {
 // sqrt(h + p_s). What of the cost no step can reduce, |r|^2 + p_s k_s^2 less that row's square,
 // is summed over all the Gaussians into one remainder (RemainderCost). The same cost, gradient
 // and J^T J, so the same linear model and steps (to rounding), with one row per Gaussian instead
-// of three: Ceres' Jacobian cells hold every row of a residual block in every one of its
-// parameter blocks' columns, so the two rows left out were zeros in each neighbour's cell, which
-// Ceres filled, checked and multiplied in every product of the conjugate gradients. On synth_skirt
-// one solve of frame 3 (BM_Solve, three alternating runs) fell from 72.6 to 66.6 ms, and 30
-// frames' CPU from 0.542 to 0.531 s a frame (medians of five alternating runs), the same steps
-// and error.
+// of two (three with a prior): Ceres' Jacobian cells hold every row of a residual block in every
+// one of its parameter blocks' columns, so the rows left out were zeros in each neighbour's cell,
+// which Ceres filled, checked and multiplied in every product of the conjugate gradients. On
+// synth_skirt one solve of frame 3 (BM_Solve, three alternating runs) fell from 72.6 to 66.6 ms,
+// and 30 frames' CPU from 0.542 to 0.531 s a frame (medians of five alternating runs), the same
+// steps and error.
 class GaussianModelRows {
  public:
   GaussianModelRows(const SimilarityTerm& term, bool secant) : term_(&term), secant_(secant) {}
