@@ -10,6 +10,7 @@
 #include <functional>
 #include <iterator>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -27,7 +28,29 @@ struct OneWorkerThread {
   ~OneWorkerThread() { SetWorkerThreads(0); }
 };
 
-// A fresh, empty folder under the test temp dir, unique per process and call.
+// The folders MakeTempDir made in this process, removed with everything in them when the process
+// ends (its static objects destroyed), so that test runs leave nothing in the temp dir. A child
+// process the tests fork ends with _exit, which leaves them to the parent.
+class TempDirsOfThisProcess {
+ public:
+  static TempDirsOfThisProcess& Get() {
+    static TempDirsOfThisProcess dirs;
+    return dirs;
+  }
+  void Add(const std::string& dir) { dirs_.push_back(dir); }
+  ~TempDirsOfThisProcess() {
+    for (const std::string& dir : dirs_) {
+      std::error_code ignored;  // Whatever cannot be removed is left, as before.
+      std::filesystem::remove_all(dir, ignored);
+    }
+  }
+
+ private:
+  std::vector<std::string> dirs_;
+};
+
+// A fresh, empty folder under the test temp dir, unique per process and call, removed when the
+// process ends.
 inline std::string MakeTempDir(const std::string& name) {
   static int counter = 0;
   const std::filesystem::path dir =
@@ -35,6 +58,7 @@ inline std::string MakeTempDir(const std::string& name) {
       ("finecap_" + name + "_" + std::to_string(getpid()) + "_" + std::to_string(counter++));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  TempDirsOfThisProcess::Get().Add(dir.string());
   return dir.string();
 }
 
