@@ -98,5 +98,29 @@ TEST_F(ProblemSizeTest, VerticesNoCameraSeesAreCounted) {
             size.num_refined_vertices);
 }
 
+// A rig with lens distortion has its images undistorted as they are read, by maps held for the
+// run: every camera's pixels count, and the forecast grows with them; a rig without has none.
+TEST(UndistortedPixelsTest, CountsTheCamerasWithDistortion) {
+  SynthOptions options = testing_util::TinyRefinableSynthOptions(1);
+  const std::string plain = testing_util::MakeTempDir("undistorted") + "/capture";
+  GenerateSyntheticCapture(options, plain);
+  EXPECT_EQ(UndistortedPixels(Capture::Open(plain)), 0.0);
+  options.cameras.distortion = {-0.1, 0.02, 0.0, 0.0, 0.0};
+  const std::string distorted = testing_util::MakeTempDir("undistorted") + "/capture";
+  GenerateSyntheticCapture(options, distorted);
+  EXPECT_EQ(UndistortedPixels(Capture::Open(distorted)),
+            options.cameras.count * double(options.cameras.width) * options.cameras.height);
+}
+
+TEST_F(ProblemSizeTest, UndistortedImagesTakeMoreMemory) {
+  const RefineOptions options = options_;
+  const SequenceModel model(input_.coarse, {}, options, "tiny");
+  const ReferenceColors colors = ComputeSequenceColors(model, input_, options);
+  const ProblemSize plain = EstimateProblemSize(model, colors, input_, options, 1, 0.0);
+  const ProblemSize undistorted = EstimateProblemSize(model, colors, input_, options, 1, 1e6);
+  EXPECT_GT(undistorted.peak_memory_mb, plain.peak_memory_mb + 1.0);
+  EXPECT_EQ(undistorted.num_pairs, plain.num_pairs);
+}
+
 }  // namespace
 }  // namespace finecap

@@ -73,8 +73,8 @@ int RunInfo(const Config& configured) {
   const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
   FrameInput input = ReadFrameInput(&capture, first);
   const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config.validation.cameras, &input);
-  const ProblemSize size =
-      EstimateProblemSize(model, colors, input, config.refine, std::max(frames.size(), 1));
+  const ProblemSize size = EstimateProblemSize(
+      model, colors, input, config.refine, std::max(frames.size(), 1), UndistortedPixels(capture));
 
   std::cout << "capture: " << capture.directory() << "\n";
   PrintCameras(capture, input.cameras, held_out, size);

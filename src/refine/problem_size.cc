@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include <glog/logging.h>
+
 #include "finecap/energy/frame_energy.h"
 #include "finecap/model/gaussian_pairs.h"
 
@@ -15,28 +17,37 @@ namespace {
 // the time of counting them all, which the forecast once did on every camera of the first frame.
 constexpr int kSampledSurfaceGaussians = 1000;
 
-// The peak resident memory of a run, fitted to nine refinements on 2 cores (bench/
-// memory_forecast.sh; the demo, synth_skirt and the temple with several sigma_hat, k_max,
-// subdivision levels and view-angle caps; 0.35 M to 85 M pairs, 115 MB to 890 MB), every one
-// within 4 % of its measured peak. The image Gaussians' own share is too small to measure.
-constexpr double kBaseMegabytes = 88.0;  // The process: code, libraries, thread stacks, allocator.
-// The 8-bit images and the buffers of one at a time.
-constexpr double kBytesPerPixel = 5.5;
-// The next frame's 8-bit images, read while this one is solved (runs of more than one frame).
-constexpr double kBytesPerPixelReadAhead = 3.0;
-// The consensus similarity's patch residuals, Jacobians and member rows, per surface Gaussian and
-// camera that sees it.
-constexpr double kConsensusBytesPerObservation = 400.0;
-// The image Gaussian's id and the pair's colour weight; the consensus similarity's pairs carry no
-// weight (every one is 1).
-constexpr double kBytesPerPair = 8.0;
-constexpr double kBytesPerConsensusPair = 4.0;
-// Residual blocks, neighbourhoods, the regulariser and the solver's sparse matrices, which grow
-// with the surface Gaussians (not with the cameras that see them): with conjugate gradients
-// (Ceres' CGNR, the default), and with the sparse Cholesky factorisation, whose normal equations
-// and factor add the rest.
-constexpr double kBytesPerSurfaceGaussian = 1400.0;
-constexpr double kBytesPerSurfaceGaussianCholesky = 3900.0;
+// The peak resident memory of a run, fitted (least squares, non-negative) to 18 refinements on 2
+// cores (bench/memory_forecast.sh and the same runs by hand: synth_demo with 512 and 128 pixel
+// cameras and with two subdivision levels, synth_skirt with 8 and 4 cameras, a wider k_max and a
+// smaller sigma_hat, the surface_color similarity, the Middlebury temple with
+// and without held-out cameras and with a smaller k_max; one frame and three; 42 to 289 MB): all
+// within 0.86-1.19 of their measured peaks, and within 0.84-1.16 when each is left out of the fit
+// (the default similarity; the surface_color similarity, three runs, 0.72-1.27).
+constexpr double kBaseMegabytes = 29.0;  // The process: code, libraries, thread stacks, allocator.
+// The 8-bit images of the frame read and the buffers of decoding them.
+constexpr double kBytesPerPixel = 4.2;
+// A camera with lens distortion: its undistortion maps, kept for the run (OpenCV's fixed-point
+// maps, 4 + 2 bytes a pixel; synth_noisy, which has distortion, peaked 46 MB above the forecast
+// without them, 5.7 bytes a pixel of its 8 cameras).
+constexpr double kBytesPerUndistortedPixel = 6.0;
+// Per frame held at once (the one solved and those prepared ahead): the pairs, while they are
+// built (the consensus energy keeps none once its colour tables are made), and the consensus
+// similarity's patch rows per surface Gaussian and camera that sees it; its colour tables are
+// counted exactly (24 B per node).
+constexpr double kBytesPerConsensusPair = 6.0;
+constexpr double kBytesPerPair = 7.4;
+constexpr double kConsensusBytesPerObservation = 40.0;
+// Residual blocks, neighbourhoods, the regulariser, the sweep's costs and the solver's sparse
+// matrices, which grow with the surface Gaussians (not with the cameras that see them): with
+// conjugate gradients (Ceres' CGNR, the default), and what the sparse Cholesky factorisation's
+// normal equations and factor add.
+constexpr double kBytesPerSurfaceGaussian = 1100.0;
+constexpr double kBytesPerSurfaceGaussianCholesky = 400.0;  // synth_skirt: 104 against 100 MB.
+// A run of several frames prepares up to two ahead while one is solved (sequence.cc), and holds
+// three frames' worth at its peak even with two frames to run (synth_skirt: 166 MB for two frames,
+// 173 MB for three).
+constexpr int kFramesHeldBySeveral = 3;
 
 // Seconds of one frame: the pairs dominate large problems (the colour tables and pair lists run
 // over them), the solver's work per Gaussian small ones. Refitted to the first frames of
@@ -49,7 +60,7 @@ constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
                                 const FrameInput& frame, const RefineOptions& options,
-                                int num_frames) {
+                                int num_frames, double undistorted_pixels) {
   ProblemSize size;
   const Mesh fine = model.Subdivide(frame.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
@@ -84,29 +95,37 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     size.num_pixels += double(frame.cameras[c].width) * frame.cameras[c].height;
   }
 
-  double bytes =
-      size.num_pixels * (kBytesPerPixel + (num_frames > 1 ? kBytesPerPixelReadAhead : 0.0)) +
-      size.num_pairs * (options.energy.similarity == SimilarityType::kConsensus
-                            ? kBytesPerConsensusPair
-                            : kBytesPerPair) +
-      size.num_surface_gaussians * (options.solver.type == SolverType::kCeres &&
-                                            options.solver.linear_solver != LinearSolverType::kCgnr
-                                        ? kBytesPerSurfaceGaussianCholesky
-                                        : kBytesPerSurfaceGaussian);
-  if (options.energy.similarity == SimilarityType::kConsensus) {
-    // Its colour tables (value and derivative, 3 floats each, per node), the residuals and
-    // Jacobians of the patches (3 channels of about 7 members, two doubles each) per observation,
-    // and the sweep's cost matrix and its smoothing copy; with more frames to come, the tables of
-    // the next, which the sequence prepares while this one is solved (PrepareFrameAhead).
+  const bool consensus = options.energy.similarity == SimilarityType::kConsensus;
+  double per_frame = size.num_pairs * (consensus ? kBytesPerConsensusPair : kBytesPerPair);
+  if (consensus) {
+    // Its colour tables: value and derivative, 3 floats each, per node.
     const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
-    const int tables = num_frames > 1 ? 2 : 1;
-    bytes += size.num_observations * (tables * nodes * 24.0 + kConsensusBytesPerObservation) +
-             size.num_surface_gaussians * options.sweep.samples * 16.0;
+    per_frame += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation);
   }
+  const bool cholesky = options.solver.type == SolverType::kCeres &&
+                        options.solver.linear_solver != LinearSolverType::kCgnr;
+  const int frames_held = num_frames > 1 ? kFramesHeldBySeveral : 1;
+  const double bytes =
+      size.num_pixels * kBytesPerPixel + undistorted_pixels * kBytesPerUndistortedPixel +
+      frames_held * per_frame +
+      size.num_surface_gaussians *
+          (kBytesPerSurfaceGaussian + (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
+  // What a refit of the constants needs beside each run's measured peak.
+  VLOG(1) << "memory forecast of " << frames_held << " frame(s) held: " << size.num_pixels
+          << " pixels, " << size.num_pairs << " pairs, " << size.num_observations
+          << " observations of " << size.num_surface_gaussians << " surface Gaussians";
   size.seconds_per_frame =
       size.num_pairs * kSecondsPerPair + size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
   return size;
+}
+
+double UndistortedPixels(const Capture& capture) {
+  double pixels = 0.0;
+  for (const Camera& camera : capture.rig()) {
+    if (camera.HasDistortion()) pixels += double(camera.width) * camera.height;
+  }
+  return pixels;
 }
 
 }  // namespace finecap

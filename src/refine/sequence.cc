@@ -245,7 +245,7 @@ class SequenceRun {
     FrameReadAhead::Frame first = reader_.Take(frames.begin);
     observer_->Starting(frames.size(), first.input,
                         EstimateProblemSize(model_, reference_colors_, first.input, options_.refine,
-                                            frames.size()));
+                                            frames.size(), UndistortedPixels(*capture_)));
     reader_.Keep(frames.begin, std::move(first));
   }
 

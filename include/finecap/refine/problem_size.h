@@ -18,6 +18,7 @@
 
 #include <vector>
 
+#include "finecap/io/capture.h"
 #include "finecap/refine/refine.h"
 
 namespace finecap {
@@ -48,12 +49,18 @@ struct ProblemSize {
 
 // The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
 // `options` (whose lengths should be resolved: scene_scale.h), in a run of `num_frames` frames
-// like it: with more than one, the next frame is read and prepared while one is solved, and the
-// memory forecast holds both. Builds the frame's image Gaussians and visibility, so it costs a
-// few seconds on a large rig, and keeps none of it.
+// like it: with more than one, up to two frames ahead are read and prepared while one is solved,
+// and the memory forecast holds three frames' worth. Builds the frame's image Gaussians and
+// visibility, so it costs a few seconds on a large rig, and keeps none of it. `undistorted_pixels`:
+// the pixels of the cameras whose images are undistorted as they are read (UndistortedPixels),
+// whose maps are held for the whole run.
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
                                 const FrameInput& frame, const RefineOptions& options,
-                                int num_frames = 1);
+                                int num_frames = 1, double undistorted_pixels = 0.0);
+
+// The pixels of `capture`'s cameras that have lens distortion, every one, held out or not: their
+// images are undistorted as they are read.
+double UndistortedPixels(const Capture& capture);
 
 }  // namespace finecap
 
