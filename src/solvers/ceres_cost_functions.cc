@@ -26,11 +26,12 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
   // with Jacobians at the same point (Ceres says so); a step is mostly taken, so one preparation
   // with Jacobians serves both. Comparing the point itself also catches a point Ceres evaluates
   // again without saying so.
-  const bool prepared = prepared_.size() == k_->size() && prepared_ == *k_;
-  const bool prepare_rows = evaluate_jacobians && rows_ != nullptr;
-  if ((!new_evaluation_point || prepared) && !(prepare_rows && !rows_prepared_)) return;
+  const bool new_point =
+      new_evaluation_point && !(prepared_.size() == k_->size() && prepared_ == *k_);
+  const bool rows_wanted = evaluate_jacobians && rows_ != nullptr;
+  if (!new_point && (!rows_wanted || rows_prepared_)) return;
   const internal::Stopwatch clock;
-  if (new_evaluation_point && !prepared) {
+  if (new_point) {
     if (summaries_only_) {
       term_->PrepareBlockSummaries(*k_);
     } else {
@@ -39,7 +40,7 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
     prepared_ = *k_;
     rows_prepared_ = false;
   }
-  if (prepare_rows && !rows_prepared_) {
+  if (rows_wanted && !rows_prepared_) {
     rows_->Prepare(*k_);
     rows_prepared_ = true;
   }

@@ -1,8 +1,8 @@
 // The Ceres pieces of the least-squares form of the energy (solver.h), with hand-written
-// Jacobians: one cost function per surface Gaussian for its similarity block of one parameter,
-// its prior and its share of the regulariser, one per similarity block of several parameters, and
-// the evaluation callback that computes the similarity's residuals once per evaluation point for
-// all blocks.
+// Jacobians: one cost function per surface Gaussian for its similarity block of one parameter (if
+// it has one), its prior and its share of the regulariser, one for what of those similarity
+// blocks no step can reduce, one per similarity block of several parameters, and the evaluation
+// callback that computes the similarity's residuals once per evaluation point for all blocks.
 #ifndef FINECAP_CERES_COST_FUNCTIONS_H_
 #define FINECAP_CERES_COST_FUNCTIONS_H_
 
