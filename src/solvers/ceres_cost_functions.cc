@@ -14,10 +14,8 @@ namespace finecap {
 
 SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k,
                                                    double* seconds)
-    : term_(term), k_(k), seconds_(seconds), summaries_only_(true) {
-  for (const SimilarityTerm::ResidualBlock& block : term->residual_blocks()) {
-    if (block.parameters.size() != 1) summaries_only_ = false;
-  }
+    : k_(k), seconds_(seconds) {
+  Rebind(term);
 }
 
 void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,

@@ -45,10 +45,10 @@ class SharedEvaluationCallback : public ceres::EvaluationCallback {
   void Rebind(SimilarityTerm* term);
 
  private:
-  SimilarityTerm* term_;
+  SimilarityTerm* term_ = nullptr;
   const Eigen::VectorXd* k_;
   double* seconds_;
-  bool summaries_only_;
+  bool summaries_only_ = true;
   Eigen::VectorXd prepared_;  // The point of the last preparation (empty before the first).
   GaussianModelRows* rows_ = nullptr;
   bool rows_prepared_ = false;  // At prepared_.
@@ -190,8 +190,8 @@ class SmoothnessBlockCost : public ceres::CostFunction {
   std::vector<Neighbour> neighbours_;
 };
 
-// The model rows of every surface Gaussian s whose similarity block has k_s as its one parameter,
-// with its prior folded in, prepared once a point for all of them. The reduced similarity rows
+// The model rows of surface Gaussians, each with its similarity block of k_s alone (if it has
+// one) and its prior folded in, prepared once a point for all of them. The reduced similarity rows
 // (ReducedOneParameterRows, with the secant's curvature h) and the prior's row sqrt(p_s) k_s
 // together are the cost 1/2 (|r|^2 + p_s k_s^2), gradient g + p_s k_s and Gauss-Newton curvature
 // h + p_s of a Gaussian; one row holds them: (g + p_s k_s) / sqrt(h + p_s), of Jacobian
@@ -324,7 +324,7 @@ class FrameCostFunctions {
   // values, the priors and the pairs' weights may all differ: a sequence's frames reuse one
   // problem.
   bool Rebind(const FrameEnergy& energy);
-  // Forgets every similarity block's secant history (ReducedSimilarityBlockCost::ForgetHistory).
+  // Forgets every secant history (ReducedSimilarityBlockCost's and GaussianModelRows').
   void ForgetHistories();
   // The rows of the Gaussians of SurfaceGaussianCost blocks, for the callback to prepare; null
   // when there are none.
