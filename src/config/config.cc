@@ -221,6 +221,15 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                     "Consensus similarity: scale of Cauchy's loss on each patch's disagreement, "
                     "as a fraction of that of unrelated patches; 0: plain least squares.",
                     0.0, 100.0);
+  schema->AddDouble("energy.consensus.sample_spacing", &energy->consensus.sample_spacing,
+                    "Consensus similarity: 0 reads a patch's colours at its surface Gaussians; "
+                    "above 0 at samples of the surface this many pixel footprints apart, at the "
+                    "images' own resolution.",
+                    0.0, 16.0);
+  schema->AddDouble("energy.consensus.sample_blur", &energy->consensus.sample_blur,
+                    "Consensus similarity with samples: standard deviation (pixels) of the blur "
+                    "of the images the samples read.",
+                    0.0, 8.0);
   schema->AddEnum("energy.overlap", &energy->overlap,
                   "Overlap of two Gaussians: the paper's printed form, the exact integral, or "
                   "patch (image Gaussians as the squares they stand for).");

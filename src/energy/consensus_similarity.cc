@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "energy/patch_agreement.h"
 #include "energy/surface_color_similarity.h"
 #include "finecap/util/error.h"
 #include "model/image_color.h"
@@ -12,6 +13,8 @@
 
 namespace finecap {
 namespace {
+
+using internal::Robustify;
 
 // A patch needs a centre and at least this many neighbours to have a shape worth comparing.
 constexpr int kMinPatchNeighbours = 3;
@@ -29,58 +32,6 @@ std::vector<int> RowsOf(const CameraPairs& pairs, int num_surface) {
     rows[pairs.surface_ids[row]] = row;
   }
   return rows;
-}
-
-// Normalises, in place, the colours q of a patch in one camera (n members of three channels):
-// z_m = (q_m - mean) / deviation with deviation = sqrt(variance + floor^2), the mean per channel
-// and the variance per channel or, when `pooled`, over all three channels (one gain for the
-// camera); and, when `dq` is not null, turns dq/dk into dz/dk:
-// dz_m/dk = (dq_m/dk - mean dq/dk - z_m <z, dq/dk>) / deviation, where <z, dq/dk> is the mean
-// over the patch (and the channels, when pooled) of z_j dq_j/dk.
-void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
-  double mean[3] = {0.0, 0.0, 0.0}, variance[3] = {0.0, 0.0, 0.0};
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) mean[channel] += q[3 * m + channel];
-  }
-  for (double& value : mean) value /= n;
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) {
-      const double difference = q[3 * m + channel] - mean[channel];
-      variance[channel] += difference * difference;
-    }
-  }
-  for (double& value : variance) value /= n;
-  if (pooled) std::fill_n(variance, 3, (variance[0] + variance[1] + variance[2]) / 3.0);
-  double inverse_deviation[3];
-  for (int channel = 0; channel < 3; ++channel) {
-    inverse_deviation[channel] = 1.0 / std::sqrt(variance[channel] + floor * floor);
-  }
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) {
-      q[3 * m + channel] = (q[3 * m + channel] - mean[channel]) * inverse_deviation[channel];
-    }
-  }
-  if (dq == nullptr) return;
-  double mean_derivative[3] = {0.0, 0.0, 0.0}, z_dot_dq[3] = {0.0, 0.0, 0.0};
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) {
-      mean_derivative[channel] += dq[3 * m + channel];
-      z_dot_dq[channel] += q[3 * m + channel] * dq[3 * m + channel];
-    }
-  }
-  for (int channel = 0; channel < 3; ++channel) {
-    mean_derivative[channel] /= n;
-    z_dot_dq[channel] /= n;
-  }
-  if (pooled) std::fill_n(z_dot_dq, 3, (z_dot_dq[0] + z_dot_dq[1] + z_dot_dq[2]) / 3.0);
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) {
-      double& derivative = dq[3 * m + channel];
-      derivative =
-          (derivative - mean_derivative[channel] - q[3 * m + channel] * z_dot_dq[channel]) *
-          inverse_deviation[channel];
-    }
-  }
 }
 
 // The values of one quantity at kLanes displacements side by side (the plane sweep's samples),
@@ -143,69 +94,6 @@ void NormaliseLanes(int n, double floor, bool pooled, const int* rows, const dou
       value = (value - mean[channel]) * inverse_deviation[channel];
     }
   }
-}
-
-// Cauchy's loss rho(s) = c2 log(1 + s / c2) of a block's sum of squares s = |r|^2 as a scaling of
-// its residuals r' = alpha r, alpha = sqrt(rho(s) / s), so that |r'|^2 = rho(s): a block that
-// disagrees far more than c2 stops pulling its Gaussian harder, and the regulariser carries its
-// neighbours' displacement into it. Then dr'/dk = alpha dr/dk + r (d alpha / ds) ds/dk.
-struct CauchyScaling {
-  double alpha = 1.0, dalpha_ds = 0.0;
-
-  CauchyScaling(double c2, double s) {
-    const double u = s / c2;
-    // Below u ~ 1e-6 the closed forms lose digits; their Taylor series are exact to O(u^2) there.
-    if (u < 1e-6) {
-      alpha = 1.0 - 0.25 * u;
-      dalpha_ds = -0.25 / c2;
-    } else {
-      const double rho = c2 * std::log1p(u);
-      const double drho = 1.0 / (1.0 + u);
-      alpha = std::sqrt(rho / s);
-      dalpha_ds = (drho * s - rho) / (2.0 * alpha * s * s);
-    }
-  }
-};
-
-// Scales a block's residuals r (and their derivatives dr/dk, when given) by Cauchy's loss of
-// scale c2 (none when c2 <= 0).
-void Robustify(double c2, int num_residuals, double* residuals, double* jacobian) {
-  if (c2 <= 0.0) return;
-  double s = 0.0, ds = 0.0;
-  for (int r = 0; r < num_residuals; ++r) {
-    s += residuals[r] * residuals[r];
-    if (jacobian != nullptr) ds += 2.0 * residuals[r] * jacobian[r];
-  }
-  const CauchyScaling scaling(c2, s);
-  for (int r = 0; r < num_residuals; ++r) {
-    if (jacobian != nullptr) {
-      jacobian[r] = scaling.alpha * jacobian[r] + residuals[r] * scaling.dalpha_ds * ds;
-    }
-    residuals[r] *= scaling.alpha;
-  }
-}
-
-// The summary of a block's residuals r' after Robustify from that of r before it, without
-// either: with s = |r|^2, g = <r, dr/dk>, h = |dr/dk|^2 and a' = d alpha / dk = (d alpha / ds) 2g,
-// |r'|^2 = alpha^2 s, <r', dr'/dk> = alpha^2 g + alpha a' s and
-// |dr'/dk|^2 = alpha^2 h + 2 alpha a' g + a'^2 s.
-// Without derivatives |r'|^2 = rho(s) alone, without alpha's square root and divisions.
-SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSummary& plain,
-                                       bool with_derivatives) {
-  if (c2 <= 0.0) return plain;
-  if (!with_derivatives && plain.squared_norm >= 1e-6 * c2) {
-    SimilarityTerm::BlockSummary robust;
-    robust.squared_norm = c2 * std::log1p(plain.squared_norm / c2);
-    return robust;
-  }
-  const CauchyScaling scaling(c2, plain.squared_norm);
-  const double alpha = scaling.alpha, dalpha_dk = scaling.dalpha_ds * 2.0 * plain.gradient;
-  SimilarityTerm::BlockSummary robust;
-  robust.squared_norm = alpha * alpha * plain.squared_norm;
-  robust.gradient = alpha * alpha * plain.gradient + alpha * dalpha_dk * plain.squared_norm;
-  robust.curvature = alpha * alpha * plain.curvature + 2.0 * alpha * dalpha_dk * plain.gradient +
-                     dalpha_dk * dalpha_dk * plain.squared_norm;
-  return robust;
 }
 
 }  // namespace
@@ -457,52 +345,21 @@ Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   std::vector<double> colors(3 * n * num_cameras);
   PatchColors(b, 0.0, colors.data(), nullptr);
-  Eigen::Vector3d variance = Eigen::Vector3d::Zero();
-  for (int a = 0; a < num_cameras; ++a) {
-    const Eigen::Map<const Eigen::Matrix3Xd> camera_colors(&colors[3 * n * a], 3, n);
-    const Eigen::Vector3d mean = camera_colors.rowwise().mean();
-    variance += (camera_colors.colwise() - mean).cwiseAbs2().rowwise().mean();
-  }
-  return (variance / num_cameras).cwiseSqrt();
+  return internal::PatchContrast(n, num_cameras, colors.data());
 }
 
 void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals,
                                          double* jacobian) const {
-  const int n = PatchSize(b), num_cameras = NumCameras(b);
-  // The colours become the residuals in place: normalised per camera, then each against the
-  // cameras' mean.
+  // The colours become the residuals in place.
   PatchColors(b, k, residuals, jacobian);
-  const int stride = 3 * n;  // From one camera's patch to the next.
-  for (int a = 0; a < num_cameras; ++a) {
-    Normalise(n, options_.contrast_floor, !options_.gain_per_channel, residuals + stride * a,
-              jacobian != nullptr ? jacobian + stride * a : nullptr);
-  }
-  const Eigen::Vector3d weight = scale_ * weights_[b];
-  const auto against_mean = [&](double* values, int m) {
-    double mean[3] = {0.0, 0.0, 0.0};
-    for (int a = 0; a < num_cameras; ++a) {
-      for (int channel = 0; channel < 3; ++channel)
-        mean[channel] += values[stride * a + 3 * m + channel];
-    }
-    for (int a = 0; a < num_cameras; ++a) {
-      for (int channel = 0; channel < 3; ++channel) {
-        double& value = values[stride * a + 3 * m + channel];
-        value = weight[channel] * (value - mean[channel] / num_cameras);
-      }
-    }
-  };
-  for (int m = 0; m < n; ++m) {
-    against_mean(residuals, m);
-    if (jacobian != nullptr) against_mean(jacobian, m);
-  }
+  internal::AgreementResiduals(PatchSize(b), NumCameras(b), options_.contrast_floor,
+                               !options_.gain_per_channel, scale_ * weights_[b], residuals,
+                               jacobian);
 }
 
 double ConsensusSimilarity::LossScale(int b) const {
-  // The level of disagreement of unrelated patches: each normalised channel has unit variance,
-  // so sum_m |z_m - mean_c z_m|^2 is about 3 n (n_c - 1) for them.
-  const double unrelated =
-      3.0 * PatchSize(b) * (NumCameras(b) - 1) * (scale_ * weights_[b]).squaredNorm() / 3.0;
-  return options_.robust_fraction * unrelated;
+  return internal::AgreementLossScale(PatchSize(b), NumCameras(b), scale_ * weights_[b],
+                                      options_.robust_fraction);
 }
 
 void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {

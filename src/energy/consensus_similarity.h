@@ -90,7 +90,8 @@ class ConsensusSimilarity : public SimilarityTerm {
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
   // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.
   // One entry per surface Gaussian; zero (the input surface) until set.
-  void SetPatchShape(const Eigen::VectorXd& shape);
+  bool ShapesPatches() const override { return true; }
+  void SetPatchShape(const Eigen::VectorXd& shape) override;
 
   // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk (when not null). At
   // the tables' nodes it is ImageColorOfPairs (surface_color_similarity.h) over the row's image

@@ -48,6 +48,8 @@ void ConsensusOptions::Check() const {
   RequireFieldRange(shape_smoothing_rounds, 0, 100, "ConsensusOptions::shape_smoothing_rounds");
   RequireFieldRange(patch_rings, 1, 4, "ConsensusOptions::patch_rings");
   RequireFieldRange(robust_fraction, 0.0, 100.0, "ConsensusOptions::robust_fraction");
+  RequireFieldRange(sample_spacing, 0.0, 16.0, "ConsensusOptions::sample_spacing");
+  RequireFieldRange(sample_blur, 0.0, 8.0, "ConsensusOptions::sample_blur");
 }
 
 }  // namespace finecap

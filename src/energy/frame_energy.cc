@@ -3,6 +3,7 @@
 #include "energy/consensus_similarity.h"
 #include "energy/input_prior.h"
 #include "energy/paper_similarity.h"
+#include "energy/pixel_consensus_similarity.h"
 #include "energy/surface_color_similarity.h"
 #include "finecap/util/error.h"
 
@@ -26,15 +27,17 @@ const EnergyOptions& Checked(const EnergyOptions& options) {
   return options;
 }
 
+// The cameras' pair lists; only their cameras when the similarity reads surface samples.
 std::vector<EnergyView> BuildViews(const SurfaceGaussians& surface,
                                    const std::vector<CameraInput>& cameras,
-                                   const EnergyOptions& options) {
+                                   const EnergyOptions& options, bool with_samples) {
   const PairOptions pair_options = EnergyPairOptions(options);
   std::vector<EnergyView> views(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
+    views[c].camera = cameras[c].camera;
+    if (with_samples) continue;
     Require(cameras[c].visible.size() == static_cast<size_t>(surface.size()),
             cameras[c].camera.name, "visibility must have one flag per surface Gaussian");
-    views[c].camera = cameras[c].camera;
     views[c].image = cameras[c].image;
     views[c].pairs = BuildCameraPairs(cameras[c].camera, *cameras[c].image, surface,
                                       cameras[c].visible, pair_options);
@@ -62,8 +65,15 @@ std::vector<std::vector<int>> SurfaceRings(const SurfaceGaussians& surface,
 std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
                                                const std::vector<EnergyView>& views,
                                                const VertexNeighbourhoods& neighbourhoods,
+                                               const SurfaceSamples& samples,
+                                               const std::vector<CameraInput>& sample_cameras,
                                                const EnergyOptions& options) {
   const OverlapForm form = options.overlap;
+  if (samples.size() > 0) {
+    Require(options.similarity == SimilarityType::kConsensus, "energy.similarity",
+            "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
+    return std::make_unique<PixelConsensusSimilarity>(samples, sample_cameras, options.consensus);
+  }
   if (options.similarity == SimilarityType::kPaper)
     return std::make_unique<PaperSimilarity>(surface, views, form);
   if (options.similarity == SimilarityType::kConsensus) {
@@ -77,11 +87,15 @@ std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
 }  // namespace
 
 FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput>& cameras,
-                         const VertexNeighbourhoods& neighbourhoods, const EnergyOptions& options)
+                         const VertexNeighbourhoods& neighbourhoods, const EnergyOptions& options,
+                         SurfaceSamples samples)
     : surface_(std::move(surface)),
       options_(Checked(options)),
-      views_(BuildViews(surface_, cameras, options_)),
-      similarity_(MakeSimilarity(surface_, views_, neighbourhoods, options_)),
+      samples_(std::move(samples)),
+      sample_cameras_(samples_.size() > 0 ? cameras : std::vector<CameraInput>()),
+      views_(BuildViews(surface_, cameras, options_, samples_.size() > 0)),
+      similarity_(
+          MakeSimilarity(surface_, views_, neighbourhoods, samples_, sample_cameras_, options_)),
       regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
                    options_.RegUnitScale()) {
   // The data curvature is measured once, at the input surface, so that the prior is a fixed

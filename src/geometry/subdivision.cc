@@ -110,13 +110,29 @@ struct OneLevel {
   Eigen::Matrix2Xi edges;
 };
 
-OneLevel SubdivideOnce(int num_vertices, const Eigen::Matrix3Xi& faces, const std::string& where) {
+// The linear scheme's edge points: the midpoints of their edges.
+void AddMidpoints(int num_vertices, const MeshEdges& edges, Triplets* triplets) {
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    triplets->emplace_back(num_vertices + e, edges.vertices(0, e), 0.5);
+    triplets->emplace_back(num_vertices + e, edges.vertices(1, e), 0.5);
+  }
+}
+
+// One level of Loop's scheme or, when `linear`, of the linear one (vertices kept, edge points at
+// the midpoints).
+OneLevel SubdivideOnce(int num_vertices, const Eigen::Matrix3Xi& faces, bool linear,
+                       const std::string& where) {
   const MeshEdges edges = BuildMeshEdges(faces);
   RequireManifoldEdges(edges, where);
   Triplets triplets;
   triplets.reserve(7 * static_cast<size_t>(num_vertices) + 4 * edges.num_edges());
-  AddVertexPoints(edges, VertexRules(num_vertices, edges), &triplets);
-  AddEdgePoints(num_vertices, faces, edges, &triplets);
+  if (linear) {
+    for (int v = 0; v < num_vertices; ++v) triplets.emplace_back(v, v, 1.0);
+    AddMidpoints(num_vertices, edges, &triplets);
+  } else {
+    AddVertexPoints(edges, VertexRules(num_vertices, edges), &triplets);
+    AddEdgePoints(num_vertices, faces, edges, &triplets);
+  }
   OneLevel level;
   level.matrix.resize(num_vertices + edges.num_edges(), num_vertices);
   level.matrix.setFromTriplets(triplets.begin(), triplets.end());
@@ -144,7 +160,10 @@ int SubdivisionStencil::FineVertexOfCoarse(int coarse_vertex) const {
   return coarse_vertex;
 }
 
-SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels, const std::string& where) {
+namespace {
+
+SubdivisionStencil BuildSubdivision(const Mesh& coarse, int levels, bool linear,
+                                    const std::string& where) {
   coarse.Validate(where);
   RequireIdsFit(coarse, levels, where);
   SubdivisionStencil stencil;
@@ -154,7 +173,7 @@ SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels, const st
   stencil.matrix.setIdentity();
   stencil.faces = coarse.faces;
   for (int l = 0; l < levels; ++l) {
-    OneLevel level = SubdivideOnce(stencil.num_fine_vertices(), stencil.faces, where);
+    OneLevel level = SubdivideOnce(stencil.num_fine_vertices(), stencil.faces, linear, where);
     if (l == 0) {
       stencil.matrix = std::move(level.matrix);  // Skips the product with the identity.
     } else {
@@ -165,6 +184,17 @@ SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels, const st
     stencil.level_edges.push_back(std::move(level.edges));
   }
   return stencil;
+}
+
+}  // namespace
+
+SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels, const std::string& where) {
+  return BuildSubdivision(coarse, levels, /*linear=*/false, where);
+}
+
+SubdivisionStencil BuildLinearSubdivision(const Mesh& coarse, int levels,
+                                          const std::string& where) {
+  return BuildSubdivision(coarse, levels, /*linear=*/true, where);
 }
 
 Mesh ApplySubdivision(const SubdivisionStencil& stencil, const Eigen::Matrix3Xd& coarse_vertices,

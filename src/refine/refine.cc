@@ -6,10 +6,10 @@
 #include <functional>
 #include <utility>
 
-#include "energy/consensus_similarity.h"
 #include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/render.h"
 #include "finecap/util/error.h"
+#include "refine/surface_sampling.h"
 
 namespace finecap {
 namespace {
@@ -32,6 +32,12 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
     if (fine[v]) ids.push_back(v);
   }
   return ids;
+}
+
+// Whether a frame is solved a second time with the images read at their own resolution.
+bool UsesSurfaceSamples(const RefineOptions& options) {
+  return options.energy.similarity == SimilarityType::kConsensus &&
+         options.energy.consensus.sample_spacing > 0.0;
 }
 
 const RefineOptions& Checked(const RefineOptions& options) {
@@ -122,12 +128,33 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 namespace {
 
+// The surface samples of a frame (ConsensusOptions::sample_spacing) and, in each of `cameras`,
+// its pixels and which samples it sees.
+SurfaceSamples SampleFrameSurface(const SequenceModel& model, const PreparedFrame& frame,
+                                  const SurfaceGaussians& surface, const FrameInput& input,
+                                  const RefineOptions& options, std::vector<CameraInput>* cameras) {
+  const ConsensusOptions& consensus = options.energy.consensus;
+  const int levels = SampleLevels(frame.fine, input.cameras, consensus.sample_spacing);
+  Mesh sample_mesh;
+  SurfaceSamples samples = SampleSurface(frame.fine, frame.normals, surface, model.neighbourhoods(),
+                                         consensus.patch_rings, levels, &sample_mesh);
+  const auto visible =
+      ComputeFrameVisibility(sample_mesh, samples.normals, input.cameras, options.visibility);
+  const std::vector<cv::Mat> pixels =
+      SampledImages(input, options.image.color_space, consensus.sample_blur);
+  for (size_t c = 0; c < cameras->size(); ++c) {
+    (*cameras)[c].pixels = pixels[c];
+    (*cameras)[c].samples_visible = visible[c];
+  }
+  return samples;
+}
+
 // PrepareFrame without checking `options`, over the image models `images` of the input's images
 // under options.image: the coarse levels of a schedule widen sigma_hat and the leaves past the
 // ranges that a configured value must lie in.
 PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options,
-                           std::vector<ImageGaussians> images) {
+                           std::vector<ImageGaussians> images, bool with_samples = false) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
@@ -154,8 +181,12 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
     frame.num_image_gaussians += frame.images[c].size();
   }
+  SurfaceSamples samples;
+  if (with_samples) {
+    samples = SampleFrameSurface(model, frame, surface, input, options, &cameras);
+  }
   frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                               options.energy);
+                                               options.energy, std::move(samples));
   if (!frame.energy->similarity().ReadsPairLists())
     std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
@@ -185,7 +216,7 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
 }
 
 bool ReadsImagesAfterPreparation(const RefineOptions& options) {
-  return options.coarse_to_fine.levels > 1;
+  return options.coarse_to_fine.levels > 1 || UsesSurfaceSamples(options);
 }
 
 namespace {
@@ -193,19 +224,25 @@ namespace {
 // Solve, and for the consensus similarity the further passes with patches shaped like the surface
 // found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
 // so that `worse` compares the frame by the energy it ended with.
+// Shapes the patches of `energy` like the surface `k` (when its similarity compares patches): the
+// window's displacement, not each member's noise about it (ConsensusOptions).
+void ShapePatchesLike(const Eigen::VectorXd& k, const RefineOptions& options, FrameEnergy* energy) {
+  SimilarityTerm& similarity = energy->similarity();
+  if (!similarity.ShapesPatches()) return;
+  Eigen::MatrixXd shape = k;
+  energy->regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
+                                              &shape);
+  similarity.SetPatchShape(shape.col(0));
+}
+
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
   const Eigen::VectorXd start = *k;
   FrameSolver solver(energy, options.solver, workspace);  // One Ceres problem for all the passes.
   SolverSummary summary = solver.Solve(k);
-  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy->similarity());
-  if (consensus == nullptr) return summary;
+  if (!energy->similarity().ShapesPatches()) return summary;
   for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
-    // The window's displacement, not each member's noise about it (ConsensusOptions).
-    Eigen::MatrixXd shape = *k;
-    energy->regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
-                                                &shape);
-    consensus->SetPatchShape(shape.col(0));
+    ShapePatchesLike(*k, options, energy);
     const SolverSummary more = solver.Solve(k);
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;
@@ -278,21 +315,36 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
       result.prepared_ahead
           ? std::move(ahead)
           : PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image));
-  FrameEnergy& energy = *frame.energy;
-  result.num_surface_gaussians = energy.num_parameters();
+  result.num_surface_gaussians = frame.energy->num_parameters();
   result.num_image_gaussians = frame.num_image_gaussians;
-  result.num_pairs = energy.num_pairs();
+  result.num_pairs = frame.energy->num_pairs();
   result.seconds_preparation += frame.seconds;
 
   // The frame got worse or better against where it started, before any level moved it.
   const Eigen::VectorXd initial = starting_point(&frame);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
-  result.summary = SolveFrameEnergy(&energy, options, &k, workspace);
+  result.summary = SolveFrameEnergy(frame.energy.get(), options, &k, workspace);
   if (coarse_k.size() > 0) {
-    EvaluateEnergyAndCost(&energy, initial, &result.summary.energy_start,
+    EvaluateEnergyAndCost(frame.energy.get(), initial, &result.summary.energy_start,
                           &result.summary.ls_cost_start);
-    EvaluateEnergyAndCost(&energy, k, &result.summary.energy_end, &result.summary.ls_cost_end);
+    EvaluateEnergyAndCost(frame.energy.get(), k, &result.summary.energy_end,
+                          &result.summary.ls_cost_end);
     result.summary.AddWork(coarse);
+  }
+  if (UsesSurfaceSamples(options)) {
+    // The images at their own resolution, from the surface the surface Gaussians found: the
+    // detail stage replaces the frame's energy, whose pair lists it no longer needs.
+    frame.energy.reset();
+    PreparedFrame detail =
+        PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image), true);
+    result.seconds_preparation += detail.seconds;
+    frame.energy = std::move(detail.energy);
+    ShapePatchesLike(k, options, frame.energy.get());
+    SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
+    EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,
+                          &summary.ls_cost_start);
+    summary.AddWork(result.summary);
+    result.summary = summary;
   }
   result.k_solved = k;
   result.worse = result.summary.energy_end < result.summary.energy_start;
@@ -302,7 +354,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   const double bias = BiasCompensation(options);
   result.refined = frame.fine;
   result.k = Eigen::VectorXd::Constant(frame.fine.num_vertices(), std::nan(""));
-  const std::vector<int>& ids = energy.surface().vertex_ids;
+  const std::vector<int>& ids = frame.energy->surface().vertex_ids;
   for (size_t s = 0; s < ids.size(); ++s) {
     const double displacement = result.kept_input ? 0.0 : k[s] + bias;
     result.k[ids[s]] = displacement;

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <opencv2/core.hpp>
 
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/regularizer.h"
@@ -26,6 +28,26 @@ struct CameraInput {
   Camera camera;
   const ImageGaussians* image = nullptr;
   std::vector<unsigned char> visible;
+  // With surface samples (SurfaceSamples): the image itself in the similarity's colour space
+  // (CV_32FC3), blurred by ConsensusOptions::sample_blur, and which samples the camera sees (one
+  // flag per sample).
+  cv::Mat pixels;
+  std::vector<unsigned char> samples_visible;
+};
+
+// Points of the surface about a pixel apart at which a similarity reads the images at their own
+// resolution (ConsensusOptions::sample_spacing; pixel_consensus_similarity.h). Each sample lies
+// on a face of the mesh and is a blend of the surface Gaussians at its corners.
+struct SurfaceSamples {
+  Eigen::Matrix3Xd base;     // Positions at k = 0, metres.
+  Eigen::Matrix3Xd normals;  // Unit directions they move along: the blended vertex normals.
+  // Samples x surface Gaussians: the weights of each sample's blend (its position is the blend of
+  // the surface Gaussians' positions; it moves by the blend of their shapes).
+  Eigen::SparseMatrix<double, Eigen::RowMajor> weights;
+  // patches[s]: the samples with a weight on surface Gaussian s, the one at s itself first.
+  std::vector<std::vector<int>> patches;
+
+  int size() const { return static_cast<int>(base.cols()); }
 };
 
 // The options of the pair lists the energy builds with `options` (gaussian_pairs.h).
@@ -34,8 +56,11 @@ PairOptions EnergyPairOptions(const EnergyOptions& options);
 class FrameEnergy {
  public:
   // `neighbourhoods` are over the mesh vertices (built with options.reg_rings).
+  // With `samples` (not empty; the consensus similarity only), the similarity reads the cameras'
+  // pixels at the samples instead of their image Gaussians.
   FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput>& cameras,
-              const VertexNeighbourhoods& neighbourhoods, const EnergyOptions& options);
+              const VertexNeighbourhoods& neighbourhoods, const EnergyOptions& options,
+              SurfaceSamples samples = {});
   FrameEnergy(const FrameEnergy&) = delete;
   FrameEnergy& operator=(const FrameEnergy&) = delete;
 
@@ -61,6 +86,9 @@ class FrameEnergy {
  private:
   SurfaceGaussians surface_;
   EnergyOptions options_;
+  // With samples, what the similarity reads: the samples and the cameras' pixels.
+  SurfaceSamples samples_;
+  std::vector<CameraInput> sample_cameras_;
   std::vector<EnergyView> views_;
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;

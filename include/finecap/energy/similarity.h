@@ -79,6 +79,13 @@ class SimilarityTerm {
   // the frame's energy then releases them (millions of pairs, a frame's largest list).
   virtual bool ReadsPairLists() const { return true; }
 
+  // True when the term compares patches of the surface that can be shaped like a surface found
+  // before (SetPatchShape), so that a further pass of the solver reads them as that surface.
+  virtual bool ShapesPatches() const { return false; }
+  // The shape of the patches, one displacement per surface Gaussian (zero: the input surface).
+  // Does nothing unless ShapesPatches().
+  virtual void SetPatchShape(const Eigen::VectorXd& /*shape*/) {}
+
  protected:
   // The block's summary from its residuals r and row-major Jacobian (one column), m residuals.
   static BlockSummary Summarise(const double* residuals, const double* jacobian, int m);

@@ -58,6 +58,12 @@ struct SubdivisionStencil {
 SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels,
                                         const std::string& where = "mesh");
 
+// The same for the linear scheme: every vertex keeps its position and every edge point is its
+// edge's midpoint, so the fine mesh is the coarse surface itself, its faces split into four at
+// each level (the points a similarity samples the surface at, ConsensusOptions::sample_spacing).
+SubdivisionStencil BuildLinearSubdivision(const Mesh& coarse, int levels,
+                                          const std::string& where = "mesh");
+
 // The fine mesh of one frame: vertices coarse_vertices * S^T, faces the stencil's. Throws
 // Error(where, ...) when coarse_vertices has not num_coarse_vertices columns; `where` names the
 // frame's file.

@@ -1,0 +1,251 @@
+// The consensus similarity read at surface samples (pixel_consensus_similarity.h) and the samples
+// themselves (surface_sampling.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "energy/pixel_consensus_similarity.h"
+#include "energy_fixture.h"
+#include "finecap/energy/frame_energy.h"
+#include "finecap/util/error.h"
+#include "refine/surface_sampling.h"
+
+namespace finecap {
+namespace {
+
+// A texture fixed to the world's xy plane: smooth at the scale of a few millimetres, so that
+// every camera sees it in sharp detail.
+Eigen::Vector3f WorldTexture(double x, double y) {
+  const double a = std::sin(900.0 * x + 2.0) * std::cos(700.0 * y - 1.0);
+  const double b = std::sin(1300.0 * (x + y)) * std::sin(500.0 * x - 800.0 * y + 0.5);
+  return Eigen::Vector3f(static_cast<float>(0.5 + 0.25 * a), static_cast<float>(0.5 + 0.2 * b),
+                         static_cast<float>(0.5 + 0.1 * (a - b)));
+}
+
+// What `camera` sees of the textured plane z = z_plane, in the similarity's colour space.
+cv::Mat RenderPlane(const Camera& camera, double z_plane) {
+  cv::Mat image(camera.height, camera.width, CV_32FC3);
+  const Eigen::Vector3d centre = -camera.R.transpose() * camera.t;
+  const Eigen::Matrix3d inverse_k = camera.K.inverse();
+  for (int y = 0; y < camera.height; ++y) {
+    for (int x = 0; x < camera.width; ++x) {
+      const Eigen::Vector3d ray = camera.R.transpose() * (inverse_k * Eigen::Vector3d(x, y, 1.0));
+      const double t = (z_plane - centre.z()) / ray.z();
+      const Eigen::Vector3d point = centre + t * ray;
+      const Eigen::Vector3f color = WorldTexture(point.x(), point.y());
+      image.at<cv::Vec3f>(y, x) = cv::Vec3f(color[0], color[1], color[2]);
+    }
+  }
+  return image;
+}
+
+// A flat grid 1 m in front of three cameras, sampled two levels finer than its vertices, the
+// cameras' images showing the textured plane `truth_offset` metres along the grid's normal.
+struct SampledScene {
+  Mesh mesh;
+  SurfaceGaussians surface;
+  VertexNeighbourhoods neighbourhoods;
+  SurfaceSamples samples;
+  std::vector<CameraInput> cameras;
+};
+
+SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
+  SampledScene scene;
+  scene.mesh = GridMesh(7, 7, 0.01, /*curvature=*/0.0);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(scene.mesh);
+  ReferenceColors colors;
+  colors.color_space = ColorSpace::kNormalizedRgb;
+  colors.colors.assign(scene.mesh.num_vertices(), Eigen::Vector3f(0.5f, 0.5f, 0.5f));
+  colors.valid.assign(scene.mesh.num_vertices(), 1);
+  std::vector<int> ids(scene.mesh.num_vertices());
+  for (int v = 0; v < scene.mesh.num_vertices(); ++v) ids[v] = v;
+  scene.surface = MakeSurfaceGaussians(scene.mesh.vertices, normals, ids, colors);
+  scene.neighbourhoods = BuildVertexNeighbourhoods(scene.mesh, 2);
+  scene.samples = SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods,
+                                /*patch_rings=*/1, levels, nullptr);
+  // The grid's normals point to -z, at the cameras: k moves the surface to z = -k.
+  const double z_plane = -truth_offset;
+  for (double tilt : {0.0, 0.35, -0.3}) {
+    CameraInput input;
+    input.camera = LookAtOrigin(1.0, tilt, 4000.0, 400);
+    input.visible.assign(scene.surface.size(), 1);
+    input.samples_visible.assign(scene.samples.size(), 1);
+    input.pixels = RenderPlane(input.camera, z_plane);
+    cv::GaussianBlur(input.pixels, input.pixels, cv::Size(0, 0), 0.7);
+    scene.cameras.push_back(std::move(input));
+  }
+  return scene;
+}
+
+EnergyOptions SampledOptions() {
+  EnergyOptions options;
+  options.similarity = SimilarityType::kConsensus;
+  options.k_max = 0.004;
+  options.consensus.sample_spacing = 1.0;
+  return options;
+}
+
+TEST(SurfaceSamplingTest, SamplesKeepTheVerticesAndBlendTheirCorners) {
+  const SampledScene scene = MakeSampledScene(0.0);
+  const int n = scene.mesh.num_vertices();
+  ASSERT_GT(scene.samples.size(), 10 * n);
+  for (int v = 0; v < n; ++v) {
+    EXPECT_EQ((scene.samples.base.col(v) - scene.mesh.vertices.col(v)).norm(), 0.0);
+    ASSERT_FALSE(scene.samples.patches[v].empty());
+    EXPECT_EQ(scene.samples.patches[v].front(), v);
+  }
+  // Every sample lies on the flat grid and is a convex blend of at most three corners.
+  for (int j = 0; j < scene.samples.size(); ++j) {
+    double sum = 0.0;
+    int corners = 0;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(scene.samples.weights, j);
+         it; ++it) {
+      EXPECT_GT(it.value(), 0.0);
+      sum += it.value();
+      ++corners;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+    EXPECT_LE(corners, 3);
+    EXPECT_NEAR(scene.samples.base(2, j), 0.0, 1e-15);
+  }
+  // An interior vertex's patch: the samples of its six faces, two levels finer (4 sample steps
+  // per edge), that have a weight on it: the hexagon of radius 4 without its rim, 1 + 3 * 3 * 4.
+  const int interior = 3 * 7 + 3;
+  EXPECT_EQ(scene.samples.patches[interior].size(), 37u);
+}
+
+TEST(SurfaceSamplingTest, WiderPatchesTakeTheNeighboursFacesToo) {
+  SampledScene scene = MakeSampledScene(0.0);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(scene.mesh);
+  const SurfaceSamples wide = SampleSurface(scene.mesh, normals, scene.surface,
+                                            scene.neighbourhoods, /*patch_rings=*/2, 2, nullptr);
+  const int interior = 3 * 7 + 3;
+  EXPECT_GT(wide.patches[interior].size(), 3 * scene.samples.patches[interior].size());
+  std::vector<int> sorted = wide.patches[interior];
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "a sample twice";
+}
+
+// dE/dk against central differences. The bilinear interpolant has kinks at pixel borders, so a
+// difference quotient may straddle one: a few coordinates may disagree, not more.
+TEST(PixelConsensusTest, GradientMatchesCentralDifferences) {
+  const SampledScene scene = MakeSampledScene(0.0015);
+  const FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                           scene.samples);
+  ASSERT_GT(energy.similarity().residual_blocks().size(), 20u);
+  int disagreeing = 0, checked = 0;
+  for (unsigned trial = 0; trial < 3; ++trial) {
+    const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, trial);
+    Eigen::VectorXd analytic;
+    energy.Evaluate(k, &analytic);
+    const Eigen::VectorXd numeric = NumericGradient(
+        [&](const Eigen::VectorXd& x) { return energy.Evaluate(x, nullptr); }, k, 1e-8);
+    for (int s = 0; s < k.size(); ++s) {
+      const double error = std::abs(analytic[s] - numeric[s]);
+      disagreeing += error > 1e-4 * std::max(numeric.cwiseAbs().maxCoeff(), 1e-12);
+      ++checked;
+    }
+  }
+  EXPECT_LE(disagreeing, checked / 50);
+}
+
+TEST(PixelConsensusTest, ResidualJacobiansMatchCentralDifferences) {
+  const SampledScene scene = MakeSampledScene(0.001);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                     scene.samples);
+  SimilarityTerm& term = energy.similarity();
+  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, 3);
+  const double h = 1e-8;
+  int checked = 0, disagreeing = 0;
+  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); b += 3) {
+    const auto& block = term.residual_blocks()[b];
+    ASSERT_EQ(block.parameters.size(), 1u);
+    const int R = block.num_residuals;
+    std::vector<double> residuals(R), jacobian(R), plus(R), minus(R);
+    term.PrepareResiduals(k, true);
+    term.BlockResiduals(b, residuals.data(), jacobian.data());
+    Eigen::VectorXd shifted = k;
+    shifted[block.parameters[0]] += h;
+    term.PrepareResiduals(shifted, false);
+    term.BlockResiduals(b, plus.data(), nullptr);
+    shifted[block.parameters[0]] -= 2 * h;
+    term.PrepareResiduals(shifted, false);
+    term.BlockResiduals(b, minus.data(), nullptr);
+    const double scale =
+        Eigen::Map<const Eigen::VectorXd>(jacobian.data(), R).cwiseAbs().maxCoeff();
+    for (int r = 0; r < R; ++r) {
+      const double numeric = (plus[r] - minus[r]) / (2 * h);
+      disagreeing += std::abs(numeric - jacobian[r]) > 1e-4 * std::max(scale, 1e-12);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_LE(disagreeing, checked / 100);
+}
+
+TEST(PixelConsensusTest, ScalarIsMinusHalfTheSumOfTheBlockCosts) {
+  const SampledScene scene = MakeSampledScene(0.001);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                     scene.samples);
+  SimilarityTerm& term = energy.similarity();
+  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, 8);
+  std::vector<double> costs;
+  term.BlockCosts(k, &costs);
+  term.PrepareBlockSummaries(k);
+  double sum = 0.0;
+  for (size_t b = 0; b < costs.size(); ++b) {
+    EXPECT_NEAR(term.BlockSummaryOf(static_cast<int>(b)).squared_norm, costs[b],
+                1e-12 * std::max(costs[b], 1.0));
+    sum += costs[b];
+  }
+  EXPECT_GT(sum, 0.0);
+  EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
+}
+
+// The samples see the texture at the images' resolution: with every k the same, the similarity
+// is best where the textured plane truly is, within a small fraction of the vertex spacing.
+TEST(PixelConsensusTest, UniformDisplacementIsBestAtTheTruePlane) {
+  for (double truth : {-0.0012, 0.0, 0.0017}) {
+    const SampledScene scene = MakeSampledScene(truth);
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                       scene.samples);
+    double best_k = 0.0, best = -std::numeric_limits<double>::infinity();
+    for (double k = -0.003; k <= 0.003; k += 0.0001) {
+      const double value = energy.similarity().Evaluate(
+          Eigen::VectorXd::Constant(energy.num_parameters(), k), nullptr);
+      if (value > best) {
+        best = value;
+        best_k = k;
+      }
+    }
+    EXPECT_NEAR(best_k, truth, 0.00015) << "truth " << truth;
+  }
+}
+
+// A patch shaped like the surface found before reads each sample at the blend of that shape.
+TEST(PixelConsensusTest, PatchShapeMovesTheSamplesByTheBlendedShape) {
+  const SampledScene scene = MakeSampledScene(0.0);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                     scene.samples);
+  SimilarityTerm& term = energy.similarity();
+  ASSERT_TRUE(term.ShapesPatches());
+  const int n = energy.num_parameters();
+  // A shape that is the same everywhere is no shape: every sample moves with its patch's k.
+  const Eigen::VectorXd k = RandomK(n, 0.001, 4);
+  const double unshaped = term.Evaluate(k, nullptr);
+  term.SetPatchShape(Eigen::VectorXd::Constant(n, 0.0007));
+  EXPECT_NEAR(term.Evaluate(k, nullptr), unshaped, 1e-12 * std::abs(unshaped));
+  // A tilted shape changes what the patches read.
+  Eigen::VectorXd tilted(n);
+  for (int s = 0; s < n; ++s) tilted[s] = 0.1 * scene.mesh.vertices(0, s);
+  term.SetPatchShape(tilted);
+  EXPECT_GT(std::abs(term.Evaluate(k, nullptr) - unshaped), 1e-6 * std::abs(unshaped));
+  EXPECT_THROW(term.SetPatchShape(Eigen::VectorXd::Zero(n + 1)), Error);
+}
+
+}  // namespace
+}  // namespace finecap
