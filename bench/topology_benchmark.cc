@@ -30,6 +30,12 @@ void BM_LoopSubdivisionStencil(benchmark::State& state) {
 }
 BENCHMARK(BM_LoopSubdivisionStencil)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
+void BM_ButterflySubdivisionStencil(benchmark::State& state) {
+  const int levels = static_cast<int>(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(BuildButterflySubdivision(Tube(), levels));
+}
+BENCHMARK(BM_ButterflySubdivisionStencil)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
 // The per-frame cost once the stencil exists: one sparse product.
 void BM_ApplySubdivision(benchmark::State& state) {
   const SubdivisionStencil stencil = BuildLoopSubdivision(Tube(), 1);

@@ -121,6 +121,7 @@ TEST(ConfigOptionsTest, ChecksAgreeWithTheSchemaRanges) {
 TEST(ConfigOptionsTest, FieldsMapToTheirKeys) {
   EXPECT_EQ(ConfigKeyOfField("RefineOptions::sigma_hat"), "model.sigma_hat");
   EXPECT_EQ(ConfigKeyOfField("RefineOptions::warm_start"), "refine.warm_start");
+  EXPECT_EQ(ConfigKeyOfField("RefineOptions::subdivision"), "model.subdivision");
   EXPECT_EQ(ConfigKeyOfField("EnergyOptions::w_reg"), "energy.w_reg");
   EXPECT_EQ(ConfigKeyOfField("ConsensusOptions::passes"), "energy.consensus.passes");
   EXPECT_EQ(ConfigKeyOfField("SweepOptions::samples"), "refine.sweep.samples");

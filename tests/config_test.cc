@@ -41,6 +41,19 @@ TEST(ConfigTest, ReadsKeysAndKeepsDefaultsForAbsentOnes) {
   EXPECT_EQ(config.frame_range().end, 5);
 }
 
+TEST(ConfigTest, SubdivisionSchemeIsAChoiceOfLoopAndButterfly) {
+  EXPECT_EQ(LoadConfig("", {}).refine.subdivision, SubdivisionScheme::kLoop);
+  const std::string file = WriteTempFile("butterfly.yaml", "model:\n  subdivision: butterfly\n");
+  EXPECT_EQ(LoadConfig(file, {}).refine.subdivision, SubdivisionScheme::kButterfly);
+  EXPECT_EQ(LoadConfig("", {{"model.subdivision", "loop", "--set"}}).refine.subdivision,
+            SubdivisionScheme::kLoop);
+  const std::string message = ErrorMessage([] {
+    LoadConfig("", {{"model.subdivision", "catmull_clark", "--set"}});
+  });
+  EXPECT_NE(message.find("model.subdivision"), std::string::npos) << message;
+  EXPECT_NE(message.find("loop, butterfly"), std::string::npos) << message;
+}
+
 TEST(ConfigTest, OverridesWinOverTheFile) {
   const std::string file = WriteTempFile("override.yaml", "runtime:\n  threads: 3\n");
   const Config config = LoadConfig(

@@ -13,6 +13,8 @@
 
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
+#include "finecap/geometry/subdivision.h"
+#include "finecap/io/mesh_io.h"
 #include "finecap/refine/frame_stats.h"
 #include "finecap/synth/synth.h"
 #include "finecap/util/atomic_file.h"
@@ -176,6 +178,45 @@ TEST(RefineSequenceTest, ReferenceColoursOfAnotherRecipeAreRefused) {
         RefineSequence(&capture, {0, 2}, wider, out);
       },
       {"reference_colors.txt", "sigma_hat"});
+}
+
+// The refined mesh (meshes/<frame>.ply) is the subdivided input moved along its normals; with the
+// butterfly scheme and nothing solved it is the subdivided input itself, whose first vertices are
+// the input's own, bit for bit, where Loop's scheme moves them.
+TEST(RefineSequenceTest, ButterflyWithoutIterationsWritesTheInputVerticesUnmoved) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_butterfly");
+  const std::string capture = root + "/capture";
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(1), capture);
+  const Mesh coarse = Capture::Open(capture).ReadCoarseMesh(0);
+  const int num_coarse = coarse.num_vertices();
+  auto refine = [&](SubdivisionScheme scheme) {
+    Config config = testing_util::TinyRunConfig(capture, root + "/" + EnumToString(scheme), 0);
+    config.eval.flow = "none";
+    config.refine.subdivision = scheme;
+    config.refine.sweep.samples = 0;
+    EXPECT_EQ(RunRefine(config), 0);
+    return ReadMesh(FrameFilesIn(config.output.dir, "000000", MeshFormat::kPly).mesh);
+  };
+
+  const Mesh butterfly = refine(SubdivisionScheme::kButterfly);
+  const SubdivisionStencil stencil = BuildButterflySubdivision(coarse, 1);
+  ASSERT_EQ(butterfly.num_vertices(), stencil.num_fine_vertices());
+  EXPECT_EQ(butterfly.faces, stencil.faces);
+  EXPECT_TRUE((butterfly.vertices.leftCols(num_coarse).array() == coarse.vertices.array()).all());
+  const Mesh subdivided = ApplySubdivision(stencil, coarse.vertices);
+  EXPECT_LT((butterfly.vertices - subdivided.vertices).cwiseAbs().maxCoeff(), 1e-12);
+
+  const Mesh loop = refine(SubdivisionScheme::kLoop);
+  ASSERT_EQ(loop.num_vertices(), butterfly.num_vertices());
+  EXPECT_GT((loop.vertices.leftCols(num_coarse) - coarse.vertices).cwiseAbs().maxCoeff(), 1e-4);
+
+  // The reference colours of one scheme do not serve the other.
+  SequenceOptions options;
+  const std::string loop_recipe = ReferenceColorRecipe(options);
+  options.refine.subdivision = SubdivisionScheme::kButterfly;
+  EXPECT_EQ(loop_recipe.find("subdivision="), std::string::npos);
+  EXPECT_NE(ReferenceColorRecipe(options).find(" subdivision=butterfly"), std::string::npos);
 }
 
 // Ceres leaves the frame ahead one of the threads it was given, keeps at least one, and the rest

@@ -1,6 +1,9 @@
 #include "finecap/geometry/subdivision.h"
 
+#include <algorithm>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -8,6 +11,7 @@
 #include "finecap/geometry/mesh_edges.h"
 #include "finecap/util/error.h"
 #include "test_meshes.h"
+#include "test_util.h"
 
 namespace finecap {
 namespace {
@@ -16,6 +20,7 @@ using testing_meshes::GridId;
 using testing_meshes::GridMesh;
 using testing_meshes::Icosahedron;
 using testing_meshes::TubeMesh;
+using testing_util::ExpectErrorMentions;
 
 // Moves every vertex by a random offset, so that stencil weights show in the positions.
 Mesh Jittered(Mesh mesh, double amount, unsigned seed = 3) {
@@ -37,6 +42,47 @@ int EdgePoint(const SubdivisionStencil& stencil, int a, int b) {
   }
   ADD_FAILURE() << "no edge " << a << "-" << b;
   return 0;
+}
+
+// The unit cube, each face split along a diagonal into two outward triangles: corners of valence
+// 3 to 6.
+Mesh TriangulatedCube() {
+  Mesh cube;
+  cube.vertices.resize(3, 8);
+  for (int v = 0; v < 8; ++v) {
+    cube.vertices.col(v) << double(v & 1), double((v >> 1) & 1), double((v >> 2) & 1);
+  }
+  cube.vertices.array() -= 0.5;
+  cube.faces.resize(3, 12);
+  cube.faces << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1,  //
+      2, 3, 5, 7, 1, 5, 6, 7, 4, 6, 3, 7,            //
+      3, 1, 7, 6, 5, 4, 7, 3, 6, 2, 7, 5;
+  return cube;
+}
+
+// A fan of `valence` triangles around vertex 0 (at the origin, lifted by `lift`): the rim vertices
+// 1 .. valence on a jittered circle, on the fan's boundary. Vertex 0 is interior, of that valence.
+Mesh Fan(int valence, double lift = 0.3) {
+  Mesh fan;
+  fan.vertices.resize(3, valence + 1);
+  fan.vertices.col(0) << 0.0, 0.0, lift;
+  for (int i = 0; i < valence; ++i) {
+    const double angle = 2.0 * M_PI * i / valence;
+    fan.vertices.col(i + 1) << std::cos(angle), std::sin(angle), 0.0;
+  }
+  fan.faces.resize(3, valence);
+  for (int i = 0; i < valence; ++i) fan.faces.col(i) << 0, i + 1, (i + 1) % valence + 1;
+  return Jittered(fan, 0.1);
+}
+
+// Row `row` of S as (column, weight) pairs, sorted by column.
+std::vector<std::pair<int, double>> Row(const SubdivisionStencil& stencil, int row) {
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> rows = stencil.matrix;
+  std::vector<std::pair<int, double>> entries;
+  for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(rows, row); it; ++it) {
+    if (it.value() != 0.0) entries.emplace_back(static_cast<int>(it.col()), it.value());
+  }
+  return entries;
 }
 
 TEST(SubdivisionTest, VertexAndFaceCountsGrowByEdgesAndFour) {
@@ -148,16 +194,20 @@ TEST(SubdivisionTest, TubeHemsStayInTheirPlanes) {
 }
 
 TEST(SubdivisionTest, PlanarMeshStaysPlanar) {
-  Mesh grid = Jittered(GridMesh(6, 5), 0.3);
-  const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.5, 1.0).normalized();
-  // Project the jittered points onto the plane normal . x = 0.7.
-  for (int v = 0; v < grid.num_vertices(); ++v) {
-    const Eigen::Vector3d p = grid.vertices.col(v);
-    grid.vertices.col(v) = p - (normal.dot(p) - 0.7) * normal;
+  for (const Mesh& mesh : {GridMesh(6, 5), Fan(5)}) {
+    Mesh planar = Jittered(mesh, 0.3);
+    const Eigen::Vector3d normal = Eigen::Vector3d(0.3, -0.5, 1.0).normalized();
+    // Project the jittered points onto the plane normal . x = 0.7.
+    for (int v = 0; v < planar.num_vertices(); ++v) {
+      const Eigen::Vector3d p = planar.vertices.col(v);
+      planar.vertices.col(v) = p - (normal.dot(p) - 0.7) * normal;
+    }
+    for (SubdivisionScheme scheme : {SubdivisionScheme::kLoop, SubdivisionScheme::kButterfly}) {
+      const Mesh fine = ApplySubdivision(BuildSubdivision(scheme, planar, 2), planar.vertices);
+      const Eigen::ArrayXd heights = (normal.transpose() * fine.vertices).array() - 0.7;
+      EXPECT_LT(heights.abs().maxCoeff(), 1e-12) << EnumToString(scheme);
+    }
   }
-  const Mesh fine = ApplySubdivision(BuildLoopSubdivision(grid, 2), grid.vertices);
-  const Eigen::ArrayXd heights = (normal.transpose() * fine.vertices).array() - 0.7;
-  EXPECT_LT(heights.abs().maxCoeff(), 1e-12);
 }
 
 // A geodesic sphere: the icosahedron's triangles split `levels` times, each new vertex the
@@ -209,15 +259,20 @@ TEST(SubdivisionTest, LevelsComposeAsRepeatedSubdivision) {
   EXPECT_LT((direct.vertices - twice.vertices).cwiseAbs().maxCoeff(), 1e-12);
 }
 
+// For a mesh around the origin whose faces all see it from inside (a convex closed surface).
+void ExpectEveryTriangleFacesOutwards(const Mesh& mesh) {
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.vertices.col(mesh.faces(0, f));
+    const Eigen::Vector3d b = mesh.vertices.col(mesh.faces(1, f));
+    const Eigen::Vector3d c = mesh.vertices.col(mesh.faces(2, f));
+    EXPECT_GT((b - a).cross(c - a).dot(a + b + c), 0.0) << "triangle " << f << " faces inwards";
+  }
+}
+
 TEST(SubdivisionTest, FineFacesKeepTheOrientation) {
   const Mesh ico = Icosahedron();
   const Mesh fine = ApplySubdivision(BuildLoopSubdivision(ico, 2), ico.vertices);
-  for (int f = 0; f < fine.num_faces(); ++f) {
-    const Eigen::Vector3d a = fine.vertices.col(fine.faces(0, f));
-    const Eigen::Vector3d b = fine.vertices.col(fine.faces(1, f));
-    const Eigen::Vector3d c = fine.vertices.col(fine.faces(2, f));
-    EXPECT_GT((b - a).cross(c - a).dot(a + b + c), 0.0) << "triangle " << f << " faces inwards";
-  }
+  ExpectEveryTriangleFacesOutwards(fine);
 }
 
 TEST(SubdivisionTest, MaskKeepsEdgePointsWhoseParentsAreBothIn) {
@@ -261,6 +316,192 @@ TEST(SubdivisionTest, RefusesNonManifoldEdgesAndWrongFrames) {
     EXPECT_NE(message.find("11 vertices but the subdivision was built for 12"), std::string::npos)
         << message;
   }
+}
+
+// The neighbours of vertex v of a convex closed mesh in order around it (by angle about the
+// direction to v), starting at `first`: the order Zorin's weights run in.
+std::vector<int> RingByAngle(const Mesh& mesh, int v, int first) {
+  std::vector<int> ring;
+  for (int f = 0; f < mesh.num_faces(); ++f) {
+    for (int corner = 0; corner < 3; ++corner) {
+      if (mesh.faces(corner, f) == v) ring.push_back(mesh.faces((corner + 1) % 3, f));
+    }
+  }
+  const Eigen::Vector3d axis = mesh.vertices.col(v).normalized();
+  const Eigen::Vector3d x = (mesh.vertices.col(first) - mesh.vertices.col(v)).normalized();
+  const Eigen::Vector3d y = axis.cross(x);
+  auto angle = [&](int u) {
+    const Eigen::Vector3d d = mesh.vertices.col(u) - mesh.vertices.col(v);
+    const double a = std::atan2(d.dot(y), d.dot(x));
+    return a < -1e-9 ? a + 2.0 * M_PI : a;
+  };
+  std::sort(ring.begin(), ring.end(), [&](int a, int b) { return angle(a) < angle(b); });
+  return ring;
+}
+
+double ZorinWeight(int j, int valence) {
+  const double angle = 2.0 * M_PI * j / valence;
+  return (0.25 + std::cos(angle) + 0.5 * std::cos(2.0 * angle)) / valence;
+}
+
+// 3/4 of v and Zorin's weights of its ring, from the edge's other end on.
+Eigen::Vector3d ZorinStencil(const Mesh& mesh, int v, int other) {
+  const std::vector<int> ring = RingByAngle(mesh, v, other);
+  const int valence = static_cast<int>(ring.size());
+  Eigen::Vector3d point = 0.75 * mesh.vertices.col(v);
+  for (int j = 0; j < valence; ++j) point += ZorinWeight(j, valence) * mesh.vertices.col(ring[j]);
+  return point;
+}
+
+TEST(ButterflySubdivisionTest, SchemesHaveTheirNames) {
+  EXPECT_EQ(EnumToString(SubdivisionScheme::kLoop), "loop");
+  EXPECT_EQ(EnumToString(SubdivisionScheme::kButterfly), "butterfly");
+  EXPECT_THROW(BuildSubdivision(static_cast<SubdivisionScheme>(7), Icosahedron(), 1), Error);
+}
+
+TEST(ButterflySubdivisionTest, KeepsEveryCoarseVertexAndRowsSumToOne) {
+  for (const Mesh& mesh :
+       {Icosahedron(), TriangulatedCube(), TubeMesh(7, 5), GridMesh(4, 3), Fan(3), Fan(7)}) {
+    for (int levels : {1, 2}) {
+      const Mesh jittered = Jittered(mesh, 0.05);
+      const SubdivisionStencil stencil = BuildButterflySubdivision(jittered, levels);
+      // The same topology as Loop's.
+      const SubdivisionStencil loop = BuildLoopSubdivision(jittered, levels);
+      EXPECT_EQ(stencil.faces, loop.faces);
+      ASSERT_EQ(stencil.num_fine_vertices(), loop.num_fine_vertices());
+      for (int v = 0; v < mesh.num_vertices(); ++v) {
+        const std::vector<std::pair<int, double>> identity = {{v, 1.0}};
+        EXPECT_EQ(Row(stencil, v), identity) << "coarse vertex " << v;
+      }
+      const Eigen::VectorXd sums = stencil.matrix * Eigen::VectorXd::Ones(mesh.num_vertices());
+      EXPECT_LT((sums.array() - 1.0).abs().maxCoeff(), 1e-12);
+      const Mesh fine = ApplySubdivision(stencil, jittered.vertices);
+      EXPECT_TRUE(
+          (fine.vertices.leftCols(mesh.num_vertices()).array() == jittered.vertices.array()).all());
+      EXPECT_TRUE(fine.vertices.allFinite());
+    }
+  }
+}
+
+TEST(ButterflySubdivisionTest, RegularInteriorEdgeTakesTheEightPointStencil) {
+  const int columns = 5;
+  const Mesh grid = Jittered(GridMesh(columns, 5), 0.2);
+  const SubdivisionStencil stencil = BuildButterflySubdivision(grid, 1);
+  const int a = GridId(2, 2, columns), b = GridId(3, 2, columns);
+  const int edge_point = EdgePoint(stencil, a, b);
+  // Opposite the edge: (3, 3) and (2, 1); the wings across the other sides of its two triangles:
+  // (4, 3), (2, 3), (3, 1) and (1, 1).
+  std::vector<std::pair<int, double>> expected = {{a, 0.5},
+                                                  {b, 0.5},
+                                                  {GridId(3, 3, columns), 1.0 / 8.0},
+                                                  {GridId(2, 1, columns), 1.0 / 8.0},
+                                                  {GridId(4, 3, columns), -1.0 / 16.0},
+                                                  {GridId(2, 3, columns), -1.0 / 16.0},
+                                                  {GridId(3, 1, columns), -1.0 / 16.0},
+                                                  {GridId(1, 1, columns), -1.0 / 16.0}};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(Row(stencil, edge_point), expected);
+
+  // The butterfly reproduces cubics: on a regular grid it puts a point of the graph of a cubic
+  // polynomial on the graph (Loop's 3/8, 1/8 would not).
+  Mesh graph = GridMesh(columns, 5);
+  auto height = [](double x, double y) { return 0.1 * x * x * x - 0.3 * x * y * y + 0.2 * y; };
+  for (int v = 0; v < graph.num_vertices(); ++v) {
+    graph.vertices(2, v) = height(graph.vertices(0, v), graph.vertices(1, v));
+  }
+  const Eigen::Vector3d point = ApplySubdivision(stencil, graph.vertices).vertices.col(edge_point);
+  EXPECT_NEAR(point.x(), 2.5, 1e-12);
+  EXPECT_NEAR(point.y(), 2.0, 1e-12);
+  EXPECT_NEAR(point.z(), height(2.5, 2.0), 1e-12);
+}
+
+TEST(ButterflySubdivisionTest, BoundaryEdgeTakesTheFourPointCurveRule) {
+  const int columns = 5;
+  const Mesh grid = Jittered(GridMesh(columns, 4), 0.2);
+  const SubdivisionStencil stencil = BuildButterflySubdivision(grid, 1);
+  const int edge_point = EdgePoint(stencil, GridId(2, 0, columns), GridId(3, 0, columns));
+  std::vector<std::pair<int, double>> expected = {{GridId(1, 0, columns), -1.0 / 16.0},
+                                                  {GridId(2, 0, columns), 9.0 / 16.0},
+                                                  {GridId(3, 0, columns), 9.0 / 16.0},
+                                                  {GridId(4, 0, columns), -1.0 / 16.0}};
+  EXPECT_EQ(Row(stencil, edge_point), expected);
+
+  // A closed hem stays a curve of its own: after two levels every fine vertex on the tube's
+  // lower hem lies in its plane, and the hem's vertices stay on the circle.
+  const Mesh tube = TubeMesh(12, 4, 0.4, 0.6);
+  const Mesh fine = ApplySubdivision(BuildButterflySubdivision(tube, 2), tube.vertices);
+  const MeshEdges edges = BuildMeshEdges(fine.faces);
+  for (int e = 0; e < edges.num_edges(); ++e) {
+    if (!edges.IsBoundary(e)) continue;
+    for (int end = 0; end < 2; ++end) {
+      const Eigen::Vector3d p = fine.vertices.col(edges.vertices(end, e));
+      EXPECT_TRUE(std::abs(p.z()) < 1e-12 || std::abs(p.z() - 0.6) < 1e-12) << "z = " << p.z();
+      EXPECT_NEAR(p.head<2>().norm(), 0.4, 2e-3);  // The 4-point curve rounds the 12-gon.
+    }
+  }
+}
+
+TEST(ButterflySubdivisionTest, ExtraordinaryVertexTakesZorinsWeights) {
+  const std::vector<std::vector<double>> small = {{5.0 / 12.0, -1.0 / 12.0, -1.0 / 12.0},
+                                                  {3.0 / 8.0, 0.0, -1.0 / 8.0, 0.0}};
+  for (int valence : {3, 4, 5, 7, 9}) {
+    const Mesh fan = Fan(valence);
+    const SubdivisionStencil stencil = BuildButterflySubdivision(fan, 1);
+    // The rim vertices are on the boundary: the edge from the centre to rim vertex 1 takes the
+    // centre's stencil alone, its weights running round the rim from vertex 1 (either way).
+    const int edge_point = EdgePoint(stencil, 0, 1);
+    EXPECT_DOUBLE_EQ(stencil.matrix.coeff(edge_point, 0), 0.75) << "valence " << valence;
+    for (int j = 0; j < valence; ++j) {
+      const double weight = valence < 5 ? small[valence - 3][j] : ZorinWeight(j, valence);
+      const int forward = 1 + j, backward = 1 + (valence - j) % valence;
+      EXPECT_NEAR(stencil.matrix.coeff(edge_point, forward), weight, 1e-15)
+          << "valence " << valence << ", j " << j;
+      EXPECT_NEAR(stencil.matrix.coeff(edge_point, backward), weight, 1e-15)
+          << "valence " << valence << ", j " << j;
+    }
+  }
+  EXPECT_NEAR(ZorinWeight(0, 5), 0.35, 1e-15);  // (1/4 + 1 + 1/2) / 5.
+
+  // Every vertex of the icosahedron has valence 5: each edge point is the mean of its two ends'
+  // stencils, and by symmetry all lie on the rays through the edges' midpoints at one radius.
+  const Mesh ico = Icosahedron();
+  const SubdivisionStencil stencil = BuildButterflySubdivision(ico, 1);
+  const Mesh fine = ApplySubdivision(stencil, ico.vertices);
+  const Eigen::Matrix2Xi& edges = stencil.level_edges[0];
+  const double radius = fine.vertices.col(12).norm();
+  for (int e = 0; e < edges.cols(); ++e) {
+    const int a = edges(0, e), b = edges(1, e);
+    const Eigen::Vector3d expected = 0.5 * (ZorinStencil(ico, a, b) + ZorinStencil(ico, b, a));
+    EXPECT_LT((fine.vertices.col(12 + e) - expected).norm(), 1e-12) << "edge " << a << "-" << b;
+    const Eigen::Vector3d mid = ico.vertices.col(a) + ico.vertices.col(b);
+    EXPECT_LT(fine.vertices.col(12 + e).cross(mid).norm(), 1e-12);
+    EXPECT_NEAR(fine.vertices.col(12 + e).norm(), radius, 1e-12);
+  }
+  // Interpolating, it bulges past the edges' midpoints towards the sphere.
+  EXPECT_GT(radius, (ico.vertices.col(0) + ico.vertices.col(11)).norm() / 2.0);
+}
+
+TEST(ButterflySubdivisionTest, ClosedMeshesSubdivideFacingOutwards) {
+  for (const Mesh& mesh : {Icosahedron(), TriangulatedCube()}) {
+    const Mesh fine = ApplySubdivision(BuildButterflySubdivision(mesh, 2), mesh.vertices);
+    ASSERT_EQ(fine.num_faces(), 16 * mesh.num_faces());
+    EXPECT_EQ(BuildMeshEdges(fine.faces).num_edges(), 3 * fine.num_faces() / 2);  // Closed.
+    ExpectEveryTriangleFacesOutwards(fine);
+  }
+}
+
+TEST(ButterflySubdivisionTest, RefusesWhatLoopRefuses) {
+  Mesh fan;  // Three triangles on the edge (0, 1).
+  fan.vertices = Eigen::Matrix3Xd::Random(3, 5);
+  fan.faces.resize(3, 3);
+  fan.faces << 0, 0, 0, 1, 1, 1, 2, 3, 4;
+  ExpectErrorMentions(
+      [&] { BuildButterflySubdivision(fan, 1, "fan.ply"); },
+      {"fan.ply", "edge (0, 1) is shared by 3 triangles", "non-manifold", "butterfly subdivision"});
+  EXPECT_THROW(BuildButterflySubdivision(Icosahedron(), -1), Error);
+  Mesh out_of_range = Icosahedron();
+  out_of_range.faces(1, 3) = 12;
+  ExpectErrorMentions([&] { BuildButterflySubdivision(out_of_range, 1, "bad.ply"); }, {"bad.ply"});
 }
 
 }  // namespace

@@ -82,7 +82,8 @@ int RunInfo(const Config& configured) {
   const Mesh coarse = capture.ReadCoarseMesh(0);
   std::cout << "mesh: " << coarse.num_vertices() << " vertices, " << coarse.num_faces()
             << " faces; " << size.num_fine_vertices << " vertices after "
-            << config.refine.subdivision_levels << " subdivision level(s)\n";
+            << config.refine.subdivision_levels << " subdivision level(s) ("
+            << config.refine.subdivision << ")\n";
   const SceneScale& scale = defaults.scale;
   std::cout << "scene: extent " << LengthText(scale.diagonal)
             << " (bounding-box diagonal), mean edge after subdivision "

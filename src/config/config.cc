@@ -150,7 +150,11 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                     "frame (against drift).",
                     0.0, 1.0);
   schema->AddInt("model.subdivision_levels", &refine.subdivision_levels,
-                 "Loop subdivision levels applied to the coarse mesh before refinement.", 0, 4);
+                 "Subdivision levels applied to the coarse mesh before refinement.", 0, 4);
+  schema->AddEnum("model.subdivision", &refine.subdivision,
+                  "Scheme of that subdivision: loop (approximating: moves the input's vertices "
+                  "onto a smoother surface) or butterfly (modified butterfly, interpolating: "
+                  "keeps them and places only the new vertices).");
   schema->AddDoubleOrAuto(
       "model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
       "Standard deviation of every surface Gaussian, metres (paper: 0.007); " + SigmaHatAutoText(),

@@ -78,7 +78,8 @@ std::vector<ImageGaussians> FrameImageModels(const FrameInput& input,
 
 SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& coarse_mask,
                              const RefineOptions& options, const std::string& where)
-    : stencil_(BuildLoopSubdivision(first_coarse, Checked(options).subdivision_levels, where)),
+    : stencil_(BuildSubdivision(Checked(options).subdivision, first_coarse,
+                                options.subdivision_levels, where)),
       num_coarse_vertices_(first_coarse.num_vertices()) {
   refined_vertices_ = FineMaskIds(stencil_, coarse_mask, num_coarse_vertices_);
   const Mesh fine = ApplySubdivision(stencil_, first_coarse.vertices);

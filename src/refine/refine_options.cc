@@ -39,6 +39,7 @@ void ReferenceColorOptions::Check() const {
 
 void RefineOptions::Check() const {
   RequireFieldRange(subdivision_levels, 0, 4, "RefineOptions::subdivision_levels");
+  RequireKnownChoice(subdivision, "RefineOptions::subdivision");
   RequireFieldRange(sigma_hat, 1e-5, 1.0, "RefineOptions::sigma_hat");
   RequireKnownChoice(reference_colors, "RefineOptions::reference_colors");
   image.Check();

@@ -80,7 +80,7 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
                                              const std::vector<Camera>& cameras,
                                              const std::string& where, RefineOptions* options) {
   const SubdivisionStencil stencil =
-      BuildLoopSubdivision(reference_coarse, options->subdivision_levels, where);
+      BuildSubdivision(options->subdivision, reference_coarse, options->subdivision_levels, where);
   SceneScaleDefaults defaults;
   defaults.scale =
       MeasureSceneScale(ApplySubdivision(stencil, reference_coarse.vertices, where), cameras);

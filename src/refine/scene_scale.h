@@ -90,9 +90,9 @@ struct SceneScaleDefaults {
 
 // Fills in every length of `*options` that `options->scene_lengths` marks as following from the
 // scene; lengths set explicitly stay. The marks stay too, so resolving again (on the same scene)
-// changes nothing. `reference_coarse` is the coarse
-// mesh of the reference frame, subdivided here with options->subdivision_levels; `where` names it
-// in errors. Returns what was measured and every length as chosen.
+// changes nothing. `reference_coarse` is the coarse mesh of the reference frame, subdivided here
+// as options->subdivision and options->subdivision_levels say; `where` names it in errors.
+// Returns what was measured and every length as chosen.
 SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
                                              const std::vector<Camera>& cameras,
                                              const std::string& where, RefineOptions* options);

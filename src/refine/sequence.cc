@@ -421,7 +421,10 @@ std::string ReferenceColorRecipe(const SequenceOptions& options) {
   for (size_t c = 0; c < options.held_out_cameras.size(); ++c) {
     recipe << (c == 0 ? "" : ",") << options.held_out_cameras[c];
   }
-  // Only when refined, so that the recipes of files saved before the choice existed still fit.
+  // Only when not the default (and below only when refined), so that the recipes of files saved
+  // before these choices existed still fit.
+  if (refine.subdivision != SubdivisionScheme::kLoop)
+    recipe << " subdivision=" << refine.subdivision;
   if (TakesColorsAtRefinedSurface(options)) {
     recipe << " reference_surface=refined reg_rings=" << refine.energy.reg_rings;
   }
@@ -446,6 +449,7 @@ RefineOptions ReferencePassOptions(const RefineOptions& configured, const Captur
                                    int reference_frame) {
   RefineOptions pass;
   pass.subdivision_levels = configured.subdivision_levels;
+  pass.subdivision = configured.subdivision;
   pass.energy.reg_rings = configured.energy.reg_rings;
   pass.energy.consensus.patch_rings =
       std::min(pass.energy.consensus.patch_rings, pass.energy.reg_rings);

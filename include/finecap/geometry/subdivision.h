@@ -1,9 +1,12 @@
-// Loop subdivision as a fixed linear map. Because Loop's rules depend on the connectivity only,
-// the subdivision of a sequence that shares one topology is a single sparse matrix S
-// (fine vertices x coarse vertices): every frame's fine vertices are coarse.vertices * S^T, and
-// every subdivided frame shares the fine faces, i.e. one topology again.
+// Subdivision as a fixed linear map. Because the rules of both schemes here depend on the
+// connectivity only, the subdivision of a sequence that shares one topology is a single sparse
+// matrix S (fine vertices x coarse vertices): every frame's fine vertices are coarse.vertices *
+// S^T, and every subdivided frame shares the fine faces, i.e. one topology again.
 //
-// Rules (Loop 1987, with the usual crease rules on the boundary of an open mesh):
+// Two schemes split every triangle in four the same way and differ in where the points go:
+//
+// Loop (Loop 1987, with the usual crease rules on the boundary of an open mesh) approximates: it
+// moves every input vertex towards a smoother limit surface.
 //  * interior vertex of valence n: (1 - n * beta) * v + beta * (sum of its n neighbours), with
 //    Loop's original beta(n) = (5/8 - (3/8 + 1/4 * cos(2 * pi / n))^2) / n (1/16 when n = 6, so a
 //    regular vertex keeps 5/8 of itself and takes 1/16 of each neighbour);
@@ -15,7 +18,28 @@
 //    no triangle keep their position.
 // Corners are not tagged: a boundary vertex where the boundary turns sharply is smoothed like any
 // other and rounds the corner (a closed hem, like a skirt's, has none).
-// Every row of S sums to 1, so the map is affine-invariant: planes stay planar.
+//
+// Modified butterfly (Zorin, Schroeder and Sweldens 1996) interpolates: every input vertex stays
+// exactly where it is (its row of S is the identity's) and only the edge points are placed.
+//  * interior edge (a, b) whose ends each have valence 6 or lie on the boundary: the 8-point
+//    butterfly 1/2 * (a + b) + 1/8 * (c + d) - 1/16 * (the four wing vertices), c and d opposite
+//    the edge and each wing vertex across one of the other sides of the edge's two triangles. A
+//    wing missing because that side is on the boundary is completed by reflection, x + y - z for
+//    the side (x, y) and its opposite corner z (exactly where a regular mesh would have it), so
+//    the stencil still reproduces planes;
+//  * interior edge from an interior vertex v of valence K != 6 (its neighbours p_0 .. p_{K-1} in
+//    order around it, p_0 the edge's other end): 3/4 * v + sum_j s_j * p_j with Zorin's weights
+//    s_j = (1/4 + cos(2 pi j / K) + 1/2 * cos(4 pi j / K)) / K for K >= 5, (5/12, -1/12, -1/12)
+//    for K = 3 and (3/8, 0, -1/8, 0) for K = 4; when both ends are such vertices, the mean of the
+//    two stencils;
+//  * boundary edge (a, b): the 4-point curve rule 9/16 * (a + b) - 1/16 * (a' + b'), a' and b' the
+//    next vertices along the boundary beyond a and b, so an open boundary is subdivided as an
+//    interpolating curve of its own; where a or b is on more than two boundary edges, 1/2 * (a +
+//    b).
+// An interior vertex whose triangles do not close one fan around it (two fans touching at a point)
+// has no order of its neighbours and takes the 8-point butterfly, as a boundary vertex does.
+//
+// Every row of S sums to 1 in both schemes, so the map is affine-invariant: planes stay planar.
 //
 // Vertex numbering, an invariant other code relies on: the first num_coarse_vertices fine
 // vertices are the coarse vertices, in order; then come the edge points of each level in the edge
@@ -31,8 +55,16 @@
 #include <Eigen/SparseCore>
 
 #include "finecap/geometry/mesh.h"
+#include "finecap/util/enum_names.h"
 
 namespace finecap {
+
+// The subdivision rules (see above): kLoop approximates, kButterfly (modified butterfly)
+// interpolates the coarse vertices on a smooth surface, kLinear keeps the coarse surface itself
+// (every vertex stays, every edge point at its edge's midpoint).
+enum class SubdivisionScheme { kLoop, kButterfly, kLinear };
+// loop, butterfly, linear.
+const std::vector<EnumName<SubdivisionScheme>>& EnumNames(SubdivisionScheme);
 
 struct SubdivisionStencil {
   // S: num_fine_vertices x num_coarse_vertices; row i holds the weights of fine vertex i. For
@@ -51,16 +83,21 @@ struct SubdivisionStencil {
   int FineVertexOfCoarse(int coarse_vertex) const;
 };
 
-// Builds S and the fine faces for `levels` rounds of Loop subdivision (0 gives the identity and
-// the coarse faces). Uses the connectivity of `coarse` only. Throws Error(where, ...) when the
+// Builds S and the fine faces for `levels` rounds of subdivision by `scheme` (0 gives the identity
+// and the coarse faces). Uses the connectivity of `coarse` only. Throws Error(where, ...) when the
 // mesh fails Mesh::Validate, when levels is negative or would overflow the vertex ids, or when an
-// edge is in three or more triangles (non-manifold: Loop's rules are undefined there).
+// edge is in three or more triangles (non-manifold: neither scheme's rules are defined there).
+SubdivisionStencil BuildSubdivision(SubdivisionScheme scheme, const Mesh& coarse, int levels,
+                                    const std::string& where = "mesh");
+
+// BuildSubdivision with kLoop, kButterfly and kLinear. The linear scheme's fine mesh is the coarse
+// surface itself, its faces split into four at each level: the input as given, sampled at the
+// fine vertices, and the points a similarity samples the surface at
+// (ConsensusOptions::sample_spacing).
 SubdivisionStencil BuildLoopSubdivision(const Mesh& coarse, int levels,
                                         const std::string& where = "mesh");
-
-// The same for the linear scheme: every vertex keeps its position and every edge point is its
-// edge's midpoint, so the fine mesh is the coarse surface itself, its faces split into four at
-// each level (the points a similarity samples the surface at, ConsensusOptions::sample_spacing).
+SubdivisionStencil BuildButterflySubdivision(const Mesh& coarse, int levels,
+                                             const std::string& where = "mesh");
 SubdivisionStencil BuildLinearSubdivision(const Mesh& coarse, int levels,
                                           const std::string& where = "mesh");
 

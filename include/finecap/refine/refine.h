@@ -70,9 +70,13 @@ struct SceneLengths {
 };
 
 struct RefineOptions {
-  // Loop subdivision levels applied to the coarse mesh before refinement (the paper subdivided
-  // its 1.5k-2.5k-vertex meshes to 6k-10k vertices: 1 level). Default 1.
+  // Subdivision levels applied to the coarse mesh before refinement (the paper subdivided its
+  // 1.5k-2.5k-vertex meshes to 6k-10k vertices with Loop's scheme: 1 level). Default 1.
   int subdivision_levels = 1;
+  // The scheme of that subdivision (subdivision.h): kLoop smooths the input's own vertices onto
+  // its limit surface; kButterfly keeps them where they are and places only the new vertices.
+  // Default kLoop.
+  SubdivisionScheme subdivision = SubdivisionScheme::kLoop;
   // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007. Follows from
   // the scene unless set (scene_lengths).
   double sigma_hat = 0.007;
