@@ -8,8 +8,9 @@
 #
 # Prints one "name: value" a line: ceres_frames_per_minute and paper_solver_frames_per_minute
 # (medians over the runs), the median over the runs of the ratio of the two speeds, ceres_rms_mm,
-# paper_solver_rms_mm, coarse_rms_mm (RMS over frames of the per-frame RMS error of k against the
-# truth, textured region), and the same accuracy for the paper's own E_sim with the paper's
+# paper_solver_rms_mm, coarse_rms_mm and subdivided_rms_mm (RMS over frames of the per-frame RMS
+# error against the truth, textured region; coarse: the input mesh as given, subdivided: its Loop
+# subdivision, where refinement starts), and the same accuracy for the paper's own E_sim with the paper's
 # settings (configs/paper.yaml) with both solvers: paper_esim_ceres_rms_mm,
 # paper_esim_paper_solver_rms_mm.
 set -euo pipefail
@@ -60,5 +61,6 @@ echo "ceres_to_paper_solver_speed_ratio: $(echo "$ratios" | median)"
 echo "ceres_rms_mm: $(rms_of "$work/ceres/stats.jsonl" rms_refined_mm)"
 echo "paper_solver_rms_mm: $(rms_of "$work/paper/stats.jsonl" rms_refined_mm)"
 echo "coarse_rms_mm: $(rms_of "$work/ceres/stats.jsonl" rms_coarse_mm)"
+echo "subdivided_rms_mm: $(rms_of "$work/ceres/stats.jsonl" rms_subdivided_mm)"
 echo "paper_esim_ceres_rms_mm: $(rms_of "$work/esim_ceres/stats.jsonl" rms_refined_mm)"
 echo "paper_esim_paper_solver_rms_mm: $(rms_of "$work/esim_paper/stats.jsonl" rms_refined_mm)"

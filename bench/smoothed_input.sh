@@ -14,10 +14,12 @@
 # Environment: FRAMES (default 10), ITERATIONS (synth.smoothing.iterations, default the
 # preset's), KEEP=1 to keep the capture and the run (printed), FINECAP (default build/finecap).
 #
-# Prints a line per frame, "frame <name>: input_rms_mm A refined_rms_mm B recovered_percent C"
-# (RMS of k - k_true over every refined vertex; C = 100 (1 - B / A)), then one "name: value" a
-# line: the same pooled over the sequence (pooled_input_rms_mm, pooled_refined_rms_mm,
-# pooled_recovered_percent) and the seconds taken by synth, refine and eval.
+# Prints a line per frame, "frame <name>: input_rms_mm A subdivided_rms_mm S refined_rms_mm B
+# recovered_percent C" (RMS distance to the truth over every refined vertex of the coarse mesh as
+# given, of its Loop subdivision and of the refined mesh; C = 100 (1 - B / A), against the input as
+# given), then one "name: value" a line: the same pooled over the sequence (pooled_input_rms_mm,
+# pooled_subdivided_rms_mm, pooled_refined_rms_mm, pooled_recovered_percent) and the seconds taken
+# by synth, refine and eval.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 meshes=${1:-}
@@ -56,12 +58,13 @@ eval_seconds=$(seconds_since "$start")
 
 metrics="$work/run/eval/metrics.json"
 # One line per frame in metrics.json: {"frame": "000000", ..., "figures": {"all": {"vertices": N,
-# "rms_coarse_mm": X, "rms_refined_mm": Y, ...
+# "rms_coarse_mm": X, "rms_subdivided_mm": S, "rms_refined_mm": Y, ...
 grep '^    {"frame": ' "$metrics" |
-  sed -E 's/.*"frame": "([^"]*)".*"figures": \{"all": \{[^}]*"rms_coarse_mm": ([^,]*), "rms_refined_mm": ([^,]*),.*/\1 \2 \3/' |
-  awk '{ printf "frame %s: input_rms_mm %.3f refined_rms_mm %.3f recovered_percent %.1f\n", $1, $2, $3, 100 * (1 - $3 / $2) }'
+  sed -E 's/.*"frame": "([^"]*)".*"figures": \{"all": \{[^}]*"rms_coarse_mm": ([^,]*), "rms_subdivided_mm": ([^,]*), "rms_refined_mm": ([^,]*),.*/\1 \2 \3 \4/' |
+  awk '{ printf "frame %s: input_rms_mm %.3f subdivided_rms_mm %.3f refined_rms_mm %.3f recovered_percent %.1f\n", $1, $2, $3, $4, 100 * (1 - $4 / $2) }'
 top() { grep -m1 -o "^  \"$1\": [^,]*" "$metrics" | awk '{ print $2 }'; }
 echo "pooled_input_rms_mm: $(top rms_coarse_mm)"
+echo "pooled_subdivided_rms_mm: $(top rms_subdivided_mm)"
 echo "pooled_refined_rms_mm: $(top rms_refined_mm)"
 echo "pooled_recovered_percent: $(top detail_recovered | awk '{ printf "%.1f", 100 * $1 }')"
 echo "synth_seconds: $synth_seconds"

@@ -2,12 +2,12 @@
 # The Middlebury temple (real photos, no ground truth) refined with the default settings and
 # templeSR0003, 0007, 0011 and 0015 held out (configs/temple.yaml), then measured in those views
 # by `finecap eval`: the held-out NCC (7x7 windows, the 4 nearest training views warped in) and
-# MAD of the visual hull (input) and of the refined mesh.
+# MAD of the visual hull as given (input), of its subdivision and of the refined mesh.
 #
 #   bash bench/temple_heldout.sh            # CAPTURE=DIR for a copy elsewhere; OUT=DIR keeps the run
 #
-# Prints one "name: value" a line: per held-out view heldout_ncc_input/refined and
-# heldout_mad_input/refined, the same over all views, refine_worse (the frame's flag),
+# Prints one "name: value" a line: per held-out view heldout_ncc_input/subdivided/refined and
+# heldout_mad_input/subdivided/refined, the same over all views, refine_worse (the frame's flag),
 # heldout_score_seconds (the score's share of refine), refine_seconds and refine_peak_mb (wall
 # time and peak resident memory of the whole `finecap refine`, /usr/bin/time), and eval_seconds.
 set -euo pipefail
@@ -29,18 +29,7 @@ start=$(date +%s.%N)
 build/finecap eval "${args[@]}" --set eval.flow=none >/dev/null
 end=$(date +%s.%N)
 
-python3 - "$work/run/eval/metrics.json" "$work/run/frames/000000.json" <<'PY'
-import json, sys
-metrics = json.load(open(sys.argv[1]))
-record = json.load(open(sys.argv[2]))
-for view in metrics["frames"][0]["heldout"]["views"]:
-    for key in ("ncc_input", "ncc_refined", "mad_input", "mad_refined"):
-        print(f"{view['camera']}_heldout_{key}: {view[key]:.4f}")
-for key in ("ncc_input", "ncc_refined", "mad_input", "mad_refined"):
-    print(f"heldout_{key}: {metrics['heldout_' + key]:.4f}")
-print(f"refine_worse: {str(record['worse']).lower()}")
-print(f"heldout_score_seconds: {record['seconds_heldout']:.2f}")
-PY
+python3 bench/heldout_figures.py "$work/run"
 read -r seconds kilobytes < "$work/refine.time"
 echo "refine_seconds: $seconds"
 echo "refine_peak_mb: $((kilobytes / 1024))"

@@ -153,6 +153,9 @@ TEST(ConfigSynthTest, OnlyTheDemoAndRampVariantsRampTheFolds) {
   EXPECT_EQ(smoothed.coarse, CoarseInput::kSmoothed);
   EXPECT_EQ(smoothed.fold_ramp_frames, 0);
   EXPECT_EQ(LoadConfig(configs + "synth_skirt.yaml", {}).synth.coarse, CoarseInput::kUnfolded);
+  const SynthOptions exact = LoadConfig(configs + "synth_skirt_exact.yaml", {}).synth;
+  EXPECT_EQ(exact.coarse, CoarseInput::kExact);
+  EXPECT_EQ(exact.fold_ramp_frames, 0);
 }
 
 TEST(ConfigSynthTest, CoarseInputAndSmoothingKeys) {
@@ -170,7 +173,7 @@ TEST(ConfigSynthTest, CoarseInputAndSmoothingKeys) {
 }
 
 TEST(ConfigSynthTest, SmoothingStrengthOutOfRangeIsOneErrorNamingTheKey) {
-  ExpectSetRefused("synth.coarse", "blurred", {"unfolded, smoothed"});
+  ExpectSetRefused("synth.coarse", "blurred", {"unfolded, smoothed, exact"});
   ExpectSetRefused("synth.smoothing.iterations", "0", {"outside [1, 100000]"});
   ExpectSetRefused("synth.smoothing.iterations", "2.5", {"expected an integer"});
   ExpectSetRefused("synth.smoothing.lambda", "0", {"outside [0.001, 1]"});

@@ -56,16 +56,21 @@ TEST(EvaluationTest, FiguresMatchAHandComputation) {
   Mesh refined = input;
   refined.vertices(2, 4) = k[4];
   const std::vector<int> region = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  // The coarse mesh as given lies twice as far from the truth as its subdivision.
+  const Eigen::VectorXd coarse_error = 2.0 * k_true;
   const EvaluationSamples samples =
-      MakeEvaluationSamples(input, refined, k, k_true, region, {4}, "grid");
+      MakeEvaluationSamples(input, input, refined, k, k_true, coarse_error, region, {4}, "grid");
   EXPECT_EQ(samples.textureless, std::vector<int>{4});
   EXPECT_EQ(samples.textured.size(), 8u);
 
   const EvaluationFigures figures = ComputeEvaluationFigures(samples);
   EXPECT_EQ(figures.all.coarse.count, 8);
-  EXPECT_NEAR(figures.all.coarse.rms, std::sqrt(0.25 / 8), 1e-12);
+  EXPECT_EQ(figures.all.subdivided.count, 8);
+  EXPECT_NEAR(figures.all.coarse.rms, std::sqrt(1.0 / 8), 1e-12);
+  EXPECT_NEAR(figures.all.subdivided.rms, std::sqrt(0.25 / 8), 1e-12);
   EXPECT_NEAR(figures.all.refined.rms, std::sqrt(0.0625 / 8), 1e-12);
-  EXPECT_NEAR(figures.all.detail_recovered, 0.5, 1e-12);
+  // Against the input as given, not its subdivision (which would give 0.5).
+  EXPECT_NEAR(figures.all.detail_recovered, 0.75, 1e-12);
   EXPECT_NEAR(figures.textureless.refined.rms, 0.25, 1e-12);
   EXPECT_NEAR(figures.textured.refined.rms, 0.0, 1e-12);
   // The input is flat, so its normal error is the true normals' mean tilt from +z; the refined
@@ -75,6 +80,7 @@ TEST(EvaluationTest, FiguresMatchAHandComputation) {
     tilt += std::acos(std::min(1.0, samples.normals_true.col(v).normalized().z())) * 180.0 / M_PI;
   }
   EXPECT_NEAR(figures.all.normal_error_coarse_deg, tilt / 8, 1e-9);
+  EXPECT_NEAR(figures.all.normal_error_subdivided_deg, tilt / 8, 1e-9);
   EXPECT_GT(figures.all.normal_error_refined_deg, 0.0);
   EXPECT_LT(figures.all.normal_error_refined_deg, figures.all.normal_error_coarse_deg);
 }
@@ -84,29 +90,36 @@ TEST(EvaluationTest, PooledSamplesGiveTheFiguresOfBothFrames) {
   const Eigen::VectorXd k = Eigen::VectorXd::Zero(9);
   const std::vector<int> region = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   EvaluationSamples pooled;
-  pooled.Append(MakeEvaluationSamples(input, input, k, Eigen::VectorXd::Constant(9, 0.1), region,
-                                      {}, "first"));
-  pooled.Append(MakeEvaluationSamples(input, input, k, Eigen::VectorXd::Constant(9, 0.3), region,
-                                      {}, "second"));
+  const Eigen::VectorXd first = Eigen::VectorXd::Constant(9, 0.1);
+  const Eigen::VectorXd second = Eigen::VectorXd::Constant(9, 0.3);
+  pooled.Append(MakeEvaluationSamples(input, input, input, k, first, first, region, {}, "first"));
+  pooled.Append(
+      MakeEvaluationSamples(input, input, input, k, second, 2.0 * second, region, {}, "second"));
   EXPECT_EQ(pooled.all.size(), 18u);
   EXPECT_EQ(pooled.all.back(), 17);
-  EXPECT_NEAR(ComputeEvaluationFigures(pooled).all.refined.rms, std::sqrt((0.01 + 0.09) / 2),
-              1e-12);
+  const EvaluationFigures figures = ComputeEvaluationFigures(pooled);
+  EXPECT_NEAR(figures.all.refined.rms, std::sqrt((0.01 + 0.09) / 2), 1e-12);
+  EXPECT_NEAR(figures.all.subdivided.rms, std::sqrt((0.01 + 0.09) / 2), 1e-12);
+  EXPECT_NEAR(figures.all.coarse.rms, std::sqrt((0.01 + 0.36) / 2), 1e-12);
 }
 
 TEST(EvaluationTest, RefusesMismatchedInputs) {
   const Mesh input = FlatGrid();
+  const Eigen::VectorXd nine = Eigen::VectorXd::Zero(9);
   ExpectErrorMentions(
       [&] {
-        MakeEvaluationSamples(input, input, Eigen::VectorXd::Zero(8), Eigen::VectorXd::Zero(9), {},
-                              {}, "frame_7.ply");
+        MakeEvaluationSamples(input, input, input, Eigen::VectorXd::Zero(8), nine, nine, {}, {},
+                              "frame_7.ply");
       },
       {"frame_7.ply", "expected 9 displacements"});
   ExpectErrorMentions(
       [&] {
-        MakeEvaluationSamples(input, input, Eigen::VectorXd::Zero(9), Eigen::VectorXd::Zero(9), {9},
-                              {}, "frame_7.ply");
+        MakeEvaluationSamples(input, input, input, nine, nine, Eigen::VectorXd::Zero(8), {}, {},
+                              "frame_7.ply");
       },
+      {"frame_7.ply", "8 of the coarse mesh"});
+  ExpectErrorMentions(
+      [&] { MakeEvaluationSamples(input, input, input, nine, nine, nine, {9}, {}, "frame_7.ply"); },
       {"frame_7.ply", "vertex id 9"});
 }
 
@@ -168,6 +181,13 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   EXPECT_EQ(metrics["flow_refined_texture"].as<std::string>(), "refined_reference_mesh");
   EXPECT_EQ(metrics["frames"].size(), 3u);
   EXPECT_DOUBLE_EQ(metrics["sequence"]["all"]["rms_coarse_mm"].as<double>(), rms_coarse);
+  // The subdivided input beside the input as given, and detail recovered against the latter.
+  const double rms_subdivided = metrics["rms_subdivided_mm"].as<double>();
+  EXPECT_TRUE(std::isfinite(rms_subdivided));
+  EXPECT_NE(rms_subdivided, rms_coarse);
+  EXPECT_NEAR(metrics["detail_recovered"].as<double>(),
+              1.0 - metrics["rms_refined_mm"].as<double>() / rms_coarse, 1e-9);
+  EXPECT_TRUE(std::isfinite(metrics["normal_error_subdivided_deg"].as<double>()));
 
   // Refine measures the textured region of each frame the same way, independently of eval.
   for (int i = 0; i < 3; ++i) {
@@ -175,6 +195,8 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
     const std::string name = metrics["frames"][i]["frame"].as<std::string>();
     const YAML::Node stats = YAML::LoadFile(out + "/frames/" + name + ".json");
     EXPECT_NEAR(figures["rms_coarse_mm"].as<double>(), stats["rms_coarse_mm"].as<double>(), 1e-6);
+    EXPECT_NEAR(figures["rms_subdivided_mm"].as<double>(), stats["rms_subdivided_mm"].as<double>(),
+                1e-6);
     EXPECT_NEAR(figures["rms_refined_mm"].as<double>(), stats["rms_refined_mm"].as<double>(), 1e-6);
   }
   for (const std::string frame : {"000000", "000001", "000002"}) {
@@ -197,6 +219,7 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   const std::string report = FileBytes(out + "/eval/report.html");
   EXPECT_NE(report.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(report.find("detail recovered"), std::string::npos);
+  EXPECT_NE(report.find("RMS subdivided mm"), std::string::npos);
   EXPECT_NE(report.find("flow refined px"), std::string::npos);
   // The 3D view where three.js is installed, a note in its place otherwise.
   if (FindThreeJs()) {
@@ -237,7 +260,7 @@ void WriteTruthAsRun(const std::string& capture_dir, const Config& config, const
   for (int frame = 0; frame < capture.num_frames(); ++frame) {
     const Mesh coarse = capture.ReadCoarseMesh(frame);
     Mesh truth = model.Subdivide(coarse);
-    Eigen::VectorXd k = TrueFineDisplacement(capture, model, coarse, frame);
+    Eigen::VectorXd k = TrueFineGroundTruth(capture, model, coarse, frame).k_true;
     ASSERT_EQ(k.size(), truth.num_vertices());
     k = k.array().isFinite().select(k, 0.0);
     const Eigen::Matrix3Xd normals = ComputeVertexNormals(truth);
@@ -247,6 +270,46 @@ void WriteTruthAsRun(const std::string& capture_dir, const Config& config, const
     WriteDisplacement(files.displacement, k);
     std::ofstream(files.stats) << "{}\n";
   }
+}
+
+double RootMeanSquareOfFinite(const Eigen::VectorXd& values) {
+  double squares = 0.0;
+  int count = 0;
+  for (double value : values) {
+    if (!std::isfinite(value)) continue;
+    squares += value * value;
+    ++count;
+  }
+  return std::sqrt(squares / count);
+}
+
+TEST(EvaluationTest, AnExactInputIsMeasuredAsGivenNotAsSubdivided) {
+  // The coarse vertices lie on the truth: the input as given errs only between them, while Loop's
+  // subdivision moves the coarse vertices themselves off the truth.
+  const std::string capture_dir = MakeTempDir("eval_exact") + "/capture";
+  SynthOptions synth = TinyCapture();
+  synth.coarse = CoarseInput::kExact;
+  GenerateSyntheticCapture(synth, capture_dir);
+  const Capture capture = Capture::Open(capture_dir);
+  const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), RefineOptions(),
+                            capture_dir);
+  const Mesh coarse = capture.ReadCoarseMesh(1);
+  const FineGroundTruth truth = TrueFineGroundTruth(capture, model, coarse, 1);
+  ASSERT_EQ(truth.coarse_error.size(), model.num_fine_vertices());
+  ASSERT_EQ(truth.k_true.size(), model.num_fine_vertices());
+  double at_coarse_vertices = 0.0, subdivided_at_coarse_vertices = 0.0;
+  for (int v = 0; v < coarse.num_vertices(); ++v) {
+    ASSERT_TRUE(std::isfinite(truth.coarse_error[v])) << "coarse vertex " << v;
+    at_coarse_vertices = std::max(at_coarse_vertices, std::abs(truth.coarse_error[v]));
+    subdivided_at_coarse_vertices =
+        std::max(subdivided_at_coarse_vertices, std::abs(truth.k_true[v]));
+  }
+  EXPECT_LT(at_coarse_vertices, 1e-6);  // The PLY stores single precision.
+  EXPECT_GT(subdivided_at_coarse_vertices, 1e-4);
+  const double given = RootMeanSquareOfFinite(truth.coarse_error);
+  const double subdivided = RootMeanSquareOfFinite(truth.k_true);
+  EXPECT_GT(given, 0.0);
+  EXPECT_GT(std::abs(given - subdivided), 0.05 * given) << given << " vs " << subdivided;
 }
 
 TEST(EvalCommandTest, FlowTexturesTheRefinedMeshFromItsOwnReferenceSurface) {

@@ -38,9 +38,17 @@ FrameStats SampleStats() {
   stats.kept_input = false;
   stats.prepared_ahead = true;
   stats.rms_coarse_mm = 8.37;
+  stats.rms_subdivided_mm = 8.5;
   stats.rms_refined_mm = std::nan("");
   stats.rms_textureless_coarse_mm = 0.0;
+  stats.rms_textureless_subdivided_mm = 1.5;
   stats.rms_textureless_refined_mm = -3.25;
+  stats.heldout_ncc_input = 0.5;
+  stats.heldout_ncc_subdivided = 0.25;
+  stats.heldout_ncc_refined = 0.75;
+  stats.heldout_mad_input = 12.5;
+  stats.heldout_mad_subdivided = 13.0;
+  stats.heldout_mad_refined = 11.0;
   stats.skipped_cameras = {"cam 1", "tab\there", "caf\xC3\xA9"};
   return stats;
 }
@@ -60,13 +68,29 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
   EXPECT_EQ(back.solver, stats.solver);
   EXPECT_EQ(back.similarity, stats.similarity);
   EXPECT_EQ(back.termination, stats.termination);
-  for (double FrameStats::*field :
-       {&FrameStats::energy_start, &FrameStats::energy_end, &FrameStats::ls_cost_start,
-        &FrameStats::ls_cost_end, &FrameStats::seconds, &FrameStats::seconds_preparation,
-        &FrameStats::seconds_solve, &FrameStats::seconds_evaluation,
-        &FrameStats::seconds_linear_solver, &FrameStats::seconds_similarity,
-        &FrameStats::cpu_seconds, &FrameStats::rms_coarse_mm, &FrameStats::rms_refined_mm,
-        &FrameStats::rms_textureless_coarse_mm, &FrameStats::rms_textureless_refined_mm}) {
+  for (double FrameStats::*field : {&FrameStats::energy_start,
+                                    &FrameStats::energy_end,
+                                    &FrameStats::ls_cost_start,
+                                    &FrameStats::ls_cost_end,
+                                    &FrameStats::seconds,
+                                    &FrameStats::seconds_preparation,
+                                    &FrameStats::seconds_solve,
+                                    &FrameStats::seconds_evaluation,
+                                    &FrameStats::seconds_linear_solver,
+                                    &FrameStats::seconds_similarity,
+                                    &FrameStats::cpu_seconds,
+                                    &FrameStats::rms_coarse_mm,
+                                    &FrameStats::rms_subdivided_mm,
+                                    &FrameStats::rms_refined_mm,
+                                    &FrameStats::rms_textureless_coarse_mm,
+                                    &FrameStats::rms_textureless_subdivided_mm,
+                                    &FrameStats::rms_textureless_refined_mm,
+                                    &FrameStats::heldout_ncc_input,
+                                    &FrameStats::heldout_ncc_subdivided,
+                                    &FrameStats::heldout_ncc_refined,
+                                    &FrameStats::heldout_mad_input,
+                                    &FrameStats::heldout_mad_subdivided,
+                                    &FrameStats::heldout_mad_refined}) {
     ExpectSameReal(stats.*field, back.*field);
   }
   EXPECT_EQ(back.iterations, 17);

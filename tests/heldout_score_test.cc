@@ -231,6 +231,11 @@ TEST(HeldOutRefineTest, EvalWritesHeldOutFiguresAndPictures) {
   // The stats record and eval measure the same surfaces the same way.
   const FrameStats stats = FirstRecord(root + "/run");
   EXPECT_NEAR(views[0]["ncc_input"].as<double>(), stats.heldout_ncc_input, 1e-6);
+  EXPECT_NEAR(views[0]["ncc_subdivided"].as<double>(), stats.heldout_ncc_subdivided, 1e-6);
+  EXPECT_NEAR(metrics["heldout_mad_subdivided"].as<double>(), stats.heldout_mad_subdivided, 1e-6);
+  // The input is the coarse mesh as given, a surface of its own beside its subdivision.
+  EXPECT_TRUE(std::isfinite(stats.heldout_ncc_subdivided));
+  EXPECT_NE(stats.heldout_ncc_subdivided, stats.heldout_ncc_input);
   const cv::Mat picture = cv::imread(root + "/run/eval/heldout_000000_cam03.png");
   ASSERT_FALSE(picture.empty());
   EXPECT_GT(picture.cols, 4 * picture.rows / 2);  // Five panels side by side.

@@ -275,6 +275,37 @@ TEST(SubdivisionTest, FineFacesKeepTheOrientation) {
   ExpectEveryTriangleFacesOutwards(fine);
 }
 
+TEST(SubdivisionTest, LinearSubdivisionSamplesTheCoarseTrianglesAsGiven) {
+  const Mesh ico = Jittered(Icosahedron(), 0.1);
+  const SubdivisionStencil stencil = BuildLoopSubdivision(ico, 2);
+  const Mesh linear = ApplyLinearSubdivision(stencil, ico.vertices);
+  const Mesh loop = ApplySubdivision(stencil, ico.vertices);
+  EXPECT_EQ(linear.faces, loop.faces);
+  ASSERT_EQ(linear.num_vertices(), loop.num_vertices());
+  // The coarse vertices stay where they are (Loop moves them) ...
+  EXPECT_EQ(linear.vertices.leftCols(12), ico.vertices);
+  EXPECT_GT((loop.vertices.leftCols(12) - ico.vertices).norm(), 0.1);
+  // ... and every fine triangle lies in the plane of its coarse triangle: the fine face f comes
+  // from coarse face f / 16 after two levels.
+  for (int f = 0; f < linear.faces.cols(); ++f) {
+    const Eigen::Vector3i corners = ico.faces.col(f / 16);
+    const Eigen::Vector3d a = ico.vertices.col(corners[0]);
+    const Eigen::Vector3d normal =
+        (ico.vertices.col(corners[1]) - a).cross(ico.vertices.col(corners[2]) - a).normalized();
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(normal.dot(linear.vertices.col(linear.faces(c, f)) - a), 0.0, 1e-12)
+          << "fine face " << f;
+    }
+  }
+  // The point between coarse vertices 0 and its neighbour is their midpoint.
+  const SubdivisionStencil one = BuildLoopSubdivision(ico, 1);
+  const int b = ico.faces(1, 0), a = ico.faces(0, 0);
+  EXPECT_TRUE(ApplyLinearSubdivision(one, ico.vertices)
+                  .vertices.col(EdgePoint(one, a, b))
+                  .isApprox(0.5 * (ico.vertices.col(a) + ico.vertices.col(b))));
+  EXPECT_THROW(ApplyLinearSubdivision(one, ico.vertices.leftCols(11)), Error);
+}
+
 TEST(SubdivisionTest, MaskKeepsEdgePointsWhoseParentsAreBothIn) {
   const Mesh tube = TubeMesh(6, 3);
   const SubdivisionStencil stencil = BuildLoopSubdivision(tube, 2);

@@ -211,6 +211,30 @@ TEST(SynthTest, SmoothedCoarseMeshesAreSmoothedCopiesOfTheTruth) {
   EXPECT_GT(rms(stronger.true_k), rms(smoothed.true_k));
 }
 
+TEST(SynthTest, ExactCoarseMeshesLieOnTheTruthAtTheirVertices) {
+  SynthOptions options = TinyOptions();
+  const SyntheticFrame unfolded = SyntheticCapture(options).Frame(1);
+  options.coarse = CoarseInput::kExact;
+  const SyntheticFrame exact = SyntheticCapture(options).Frame(1);
+  EXPECT_EQ(exact.truth.vertices, unfolded.truth.vertices);
+  EXPECT_EQ(exact.coarse.faces, unfolded.coarse.faces);
+  // Every coarse vertex is a vertex of the true mesh: the nearest true vertex is where it is, and
+  // the ground truth measured from it is 0.
+  for (int v = 0; v < exact.coarse.num_vertices(); ++v) {
+    const double nearest =
+        (exact.truth.vertices.colwise() - exact.coarse.vertices.col(v)).colwise().norm().minCoeff();
+    ASSERT_LT(nearest, 1e-9) << "coarse vertex " << v;
+    ASSERT_NEAR(exact.true_k(v), 0.0, 1e-9) << "coarse vertex " << v;
+  }
+  // Where there are folds it is not the unfolded input: it is moved by the fold along the smooth
+  // normal.
+  const Eigen::VectorXd moved = (exact.coarse.vertices - unfolded.coarse.vertices).colwise().norm();
+  EXPECT_GT(unfolded.folds_at_coarse.cwiseAbs().maxCoeff(), 0.005);
+  for (int v = 0; v < exact.coarse.num_vertices(); ++v) {
+    EXPECT_NEAR(moved(v), std::abs(unfolded.folds_at_coarse(v)), 1e-9) << "coarse vertex " << v;
+  }
+}
+
 TEST(SynthTest, BadSmoothingStrengthIsRefusedNamingTheKey) {
   SynthOptions options = TinyOptions();
   options.coarse = CoarseInput::kSmoothed;

@@ -80,7 +80,8 @@ TEST(TempleTest, HeldOutViewsAreScoredOnRealPhotos) {
   for (size_t h = 0; h < views.size(); ++h) {
     EXPECT_EQ(views[h]["camera"].as<std::string>(), config.validation.cameras[h]);
     EXPECT_EQ(views[h]["training"].size(), 4u);
-    for (const char* key : {"ncc_input", "ncc_refined", "mad_input", "mad_refined"}) {
+    for (const char* key : {"ncc_input", "ncc_subdivided", "ncc_refined", "mad_input",
+                            "mad_subdivided", "mad_refined"}) {
       const double value = views[h][key].as<double>();
       EXPECT_TRUE(std::isfinite(value)) << key;
     }
@@ -91,6 +92,10 @@ TEST(TempleTest, HeldOutViewsAreScoredOnRealPhotos) {
                            config.validation.cameras[h] + ".png"));
   }
   EXPECT_NEAR(metrics["heldout_ncc_input"].as<double>(), stats.heldout_ncc_input, 1e-6);
+  // Without subdivision the input as given and the subdivided input are one surface.
+  EXPECT_EQ(metrics["heldout_ncc_subdivided"].as<double>(),
+            metrics["heldout_ncc_input"].as<double>());
+  EXPECT_NEAR(stats.heldout_ncc_subdivided, stats.heldout_ncc_input, 1e-9);
 }
 
 }  // namespace

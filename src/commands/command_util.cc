@@ -180,11 +180,13 @@ class ConsoleObserver : public SequenceObserver {
     detail << "E " << stats.energy_start << " -> " << stats.energy_end << ", " << stats.iterations
            << " iterations";
     if (std::isfinite(stats.heldout_ncc_input)) {
-      detail << ", held-out NCC " << stats.heldout_ncc_input << " -> " << stats.heldout_ncc_refined;
+      detail << ", held-out NCC " << stats.heldout_ncc_input << " (subdivided "
+             << stats.heldout_ncc_subdivided << ") -> " << stats.heldout_ncc_refined;
     }
     detail << (stats.worse ? ", WORSE" : "") << (stats.kept_input ? " (input kept)" : "");
     if (std::isfinite(stats.rms_refined_mm)) {
-      detail << ", RMS vs truth " << stats.rms_coarse_mm << " -> " << stats.rms_refined_mm << " mm";
+      detail << ", RMS vs truth " << stats.rms_coarse_mm << " (subdivided "
+             << stats.rms_subdivided_mm << ") -> " << stats.rms_refined_mm << " mm";
     }
     progress_.FrameDone(stats.frame, false, detail.str());
   }
@@ -223,7 +225,8 @@ void RefineConfiguredSequence(const Config& config, const FrameRange& frames,
   if (result.measured > 0) {
     std::cout.precision(3);
     std::cout << "Error against the ground truth (textured region, RMS over the frames run now): "
-              << "input " << result.rms_coarse_mm << " mm, refined " << result.rms_refined_mm
+              << "input as given " << result.rms_coarse_mm << " mm (subdivided "
+              << result.rms_subdivided_mm << " mm), refined " << result.rms_refined_mm
               << " mm, detail recovered "
               << 100.0 * (1.0 - result.rms_refined_mm / result.rms_coarse_mm) << " %\n";
   }

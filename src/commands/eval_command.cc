@@ -52,15 +52,19 @@ void PrintFigures(const RunEvaluation& evaluation) {
   std::cout.precision(3);
   std::cout << "Evaluation: " << evaluation.report << ", " << evaluation.metrics << "\n";
   if (std::isfinite(all.coarse.rms)) {
-    std::cout << "RMS against the ground truth: input " << 1000.0 * all.coarse.rms
-              << " mm, refined " << 1000.0 * all.refined.rms << " mm; detail recovered "
+    std::cout << "RMS against the ground truth: input as given " << 1000.0 * all.coarse.rms
+              << " mm (subdivided " << 1000.0 * all.subdivided.rms << " mm), refined "
+              << 1000.0 * all.refined.rms << " mm; detail recovered "
               << 100.0 * all.detail_recovered << " %; normal error " << all.normal_error_coarse_deg
-              << " -> " << all.normal_error_refined_deg << " degrees\n";
+              << " (subdivided " << all.normal_error_subdivided_deg << ") -> "
+              << all.normal_error_refined_deg << " degrees\n";
   }
   if (!evaluation.heldout.empty()) {
+    // The input as given, its subdivision, the refined mesh.
     const std::vector<SurfaceScore>& pooled = evaluation.heldout;
-    std::cout << "Held-out cameras: NCC input " << pooled[0].ncc << ", refined " << pooled[1].ncc
-              << "; MAD input " << pooled[0].mad << ", refined " << pooled[1].mad
+    std::cout << "Held-out cameras: NCC input as given " << pooled[0].ncc << " (subdivided "
+              << pooled[1].ncc << "), refined " << pooled[2].ncc << "; MAD input as given "
+              << pooled[0].mad << " (subdivided " << pooled[1].mad << "), refined " << pooled[2].mad
               << " grey levels\n";
   }
   if (evaluation.flow_measured) {

@@ -208,8 +208,9 @@ void AddFoldsKey(std::vector<FoldComponent>* folds, ConfigSchema* schema) {
 
 void AddCoarseInputKeys(SynthOptions* synth, ConfigSchema* schema) {
   schema->AddEnum("synth.coarse", &synth->coarse,
-                  "The coarse meshes: unfolded (the true surface without its folds) or smoothed "
-                  "(the true surface Taubin-smoothed, synth.smoothing).");
+                  "The coarse meshes: unfolded (the true surface without its folds), smoothed "
+                  "(the true surface Taubin-smoothed, synth.smoothing) or exact (the true "
+                  "surface at the coarse vertices, the detail between them missing).");
   TaubinSmoothingOptions& smoothing = synth->smoothing;
   schema->AddInt("synth.smoothing.iterations", &smoothing.iterations,
                  "synth.coarse smoothed: Taubin iterations (lambda and mu step each), the "

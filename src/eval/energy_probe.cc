@@ -61,7 +61,8 @@ EnergyProbe ProbeEnergyAlongTruth(Capture* capture, int frame, const SequenceMod
   const PreparedFrame prepared = PrepareFrame(model, colors, input, options);
   const FrameEnergy& energy = *prepared.energy;
 
-  const Eigen::VectorXd truth_all = TrueFineDisplacement(*capture, model, input.coarse, frame);
+  const Eigen::VectorXd truth_all =
+      TrueFineGroundTruth(*capture, model, input.coarse, frame).k_true;
   Eigen::VectorXd truth(energy.num_parameters());
   for (int s = 0; s < truth.size(); ++s) {
     const double k = truth_all[energy.surface().vertex_ids[s]];

@@ -36,19 +36,23 @@ std::vector<int> Measured(const EvaluationSamples& samples, const std::vector<in
 }
 
 RegionFigures RegionFiguresOf(const EvaluationSamples& samples, const std::vector<int>& region) {
-  // The input is k = 0, over the vertices the refinement gave a value.
-  const Eigen::VectorXd coarse = samples.k_refined.array().isFinite().select(
+  // The baselines are where they are (k = 0 from each), over the vertices the refinement gave a
+  // value.
+  const Eigen::VectorXd zero = samples.k_refined.array().isFinite().select(
       Eigen::VectorXd::Zero(samples.k_refined.size()), samples.k_refined);
   RegionFigures figures;
-  figures.coarse = ComputeErrorStats(coarse, samples.k_true, region);
+  figures.coarse = ComputeErrorStats(zero, samples.coarse_error, region);
+  figures.subdivided = ComputeErrorStats(zero, samples.k_true, region);
   figures.refined = ComputeErrorStats(samples.k_refined, samples.k_true, region);
   figures.detail_recovered = DetailRecovered(figures.refined.rms, figures.coarse.rms);
   const std::vector<int> measured = Measured(samples, region);
   const Eigen::Matrix3Xd truth = Columns(samples.normals_true, measured);
-  figures.normal_error_coarse_deg =
-      MeanAngularErrorDegrees(Columns(samples.normals_input, measured), truth);
-  figures.normal_error_refined_deg =
-      MeanAngularErrorDegrees(Columns(samples.normals_refined, measured), truth);
+  const auto normal_error = [&](const Eigen::Matrix3Xd& normals) {
+    return MeanAngularErrorDegrees(Columns(normals, measured), truth);
+  };
+  figures.normal_error_coarse_deg = normal_error(samples.normals_coarse);
+  figures.normal_error_subdivided_deg = normal_error(samples.normals_input);
+  figures.normal_error_refined_deg = normal_error(samples.normals_refined);
   return figures;
 }
 
@@ -77,29 +81,35 @@ void EvaluationSamples::Append(const EvaluationSamples& other) {
   AppendOffset(other.textureless, offset, &textureless);
   k_refined = OneAfterTheOther(k_refined, other.k_refined);
   k_true = OneAfterTheOther(k_true, other.k_true);
+  coarse_error = OneAfterTheOther(coarse_error, other.coarse_error);
+  normals_coarse = SideBySide(normals_coarse, other.normals_coarse);
   normals_input = SideBySide(normals_input, other.normals_input);
   normals_refined = SideBySide(normals_refined, other.normals_refined);
   normals_true = SideBySide(normals_true, other.normals_true);
 }
 
-EvaluationSamples MakeEvaluationSamples(const Mesh& input, const Mesh& refined,
+EvaluationSamples MakeEvaluationSamples(const Mesh& coarse, const Mesh& input, const Mesh& refined,
                                         const Eigen::VectorXd& k_refined,
                                         const Eigen::VectorXd& k_true,
+                                        const Eigen::VectorXd& coarse_error,
                                         const std::vector<int>& refined_vertices,
                                         const std::vector<int>& textureless_vertices,
                                         const std::string& where) {
+  RequireSameTopology(input, coarse, where);
   RequireSameTopology(input, refined, where);
   const int n = input.num_vertices();
-  Require(k_refined.size() == n && k_true.size() == n, where,
+  Require(k_refined.size() == n && k_true.size() == n && coarse_error.size() == n, where,
           "expected " + std::to_string(n) + " displacements, got " +
-              std::to_string(k_refined.size()) + " refined and " + std::to_string(k_true.size()) +
-              " true");
+              std::to_string(k_refined.size()) + " refined, " + std::to_string(k_true.size()) +
+              " true and " + std::to_string(coarse_error.size()) + " of the coarse mesh");
   RequireIds(refined_vertices, n, where);
   RequireIds(textureless_vertices, n, where);
 
   EvaluationSamples samples;
   samples.k_refined = k_refined;
   samples.k_true = k_true;
+  samples.coarse_error = coarse_error;
+  samples.normals_coarse = ComputeVertexNormals(coarse);
   samples.normals_input = ComputeVertexNormals(input);
   samples.normals_refined = ComputeVertexNormals(refined);
   Mesh truth = input;

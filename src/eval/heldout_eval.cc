@@ -50,44 +50,70 @@ std::string ViewCaption(const std::string& frame_name, const HeldOutViewScore& v
   caption.precision(3);
   caption << "Frame " << frame_name << ", held-out camera " << view.camera
           << ": its image | camera " << (view.training.empty() ? "-" : view.training.front())
-          << " warped in through the input | through the refined mesh | local NCC of the input "
-          << "| of the refined mesh (mean over " << view.training.size()
+          << " warped in through the input as given | through the refined mesh | local NCC of "
+          << "the input as given | of the refined mesh (mean over " << view.training.size()
           << " training views; blue -1 to dark red 1, grey not scored). NCC "
-          << view.surfaces[0].ncc << " -> " << view.surfaces[1].ncc << ", MAD "
-          << view.surfaces[0].mad << " -> " << view.surfaces[1].mad << " grey levels";
+          << view.surfaces[kHeldOutCoarse].ncc << " (subdivided "
+          << view.surfaces[kHeldOutSubdivided].ncc << ") -> " << view.surfaces[kHeldOutRefined].ncc
+          << ", MAD " << view.surfaces[kHeldOutCoarse].mad << " (subdivided "
+          << view.surfaces[kHeldOutSubdivided].mad << ") -> " << view.surfaces[kHeldOutRefined].mad
+          << " grey levels";
   return caption.str();
 }
 
-std::string SurfaceJson(const std::vector<SurfaceScore>& surfaces) {
-  return "\"ncc_input\": " + JsonNumber(surfaces[0].ncc) +
-         ", \"ncc_refined\": " + JsonNumber(surfaces[1].ncc) +
-         ", \"mad_input\": " + JsonNumber(surfaces[0].mad) +
-         ", \"mad_refined\": " + JsonNumber(surfaces[1].mad);
+// The names metrics.json gives the surfaces, in HeldOutSurface order.
+constexpr const char* kSurfaceNames[kNumHeldOutSurfaces] = {"input", "subdivided", "refined"};
+
+// "<prefix>ncc_input": ..., the NCC of each surface, then the MAD of each, joined by
+// `separator`.
+std::string SurfaceJson(const std::vector<SurfaceScore>& surfaces, const std::string& prefix,
+                        const std::string& separator) {
+  std::vector<std::string> members;
+  for (int s = 0; s < kNumHeldOutSurfaces; ++s) {
+    members.push_back("\"" + prefix + "ncc_" + kSurfaceNames[s] +
+                      "\": " + JsonNumber(surfaces[s].ncc));
+  }
+  for (int s = 0; s < kNumHeldOutSurfaces; ++s) {
+    members.push_back("\"" + prefix + "mad_" + kSurfaceNames[s] +
+                      "\": " + JsonNumber(surfaces[s].mad));
+  }
+  std::string json = members.front();
+  for (size_t m = 1; m < members.size(); ++m) json += "," + separator + members[m];
+  return json;
 }
 
 std::vector<TableCell> ScoreRow(const std::string& name, const std::string& training,
                                 const std::vector<SurfaceScore>& surfaces) {
-  return {name, training, surfaces[0].ncc, surfaces[1].ncc, surfaces[0].mad, surfaces[1].mad};
+  return {name,
+          training,
+          surfaces[kHeldOutCoarse].ncc,
+          surfaces[kHeldOutSubdivided].ncc,
+          surfaces[kHeldOutRefined].ncc,
+          surfaces[kHeldOutCoarse].mad,
+          surfaces[kHeldOutSubdivided].mad,
+          surfaces[kHeldOutRefined].mad};
 }
 
 }  // namespace
 
 HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
                                   const HeldOutOptions& options, const std::string& frame_name,
-                                  FrameInput frame, const Mesh& input, const Mesh& refined,
-                                  const std::string& eval_dir,
+                                  FrameInput frame, const Mesh& coarse, const Mesh& input,
+                                  const Mesh& refined, const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures) {
   const std::vector<CalibratedImage> held_out = TakeHeldOutViews(held_out_cameras, &frame);
   std::vector<HeldOutViewMaps> maps;
   HeldOutFrame result{frame_name, ScoreHeldOutViews(CalibratedImagesOf(frame), held_out,
-                                                    {&input, &refined}, options, &maps)};
+                                                    {&coarse, &input, &refined}, options, &maps)};
   for (size_t h = 0; h < held_out.size(); ++h) {
     const cv::Mat& image = held_out[h].image;
     const cv::Rect box = WarpedBox(maps[h], image.size());
+    const HeldOutViewMaps& view = maps[h];
     cv::Mat picture;
-    cv::hconcat(std::vector<cv::Mat>{image(box), maps[h].warped[0](box), maps[h].warped[1](box),
-                                     NccPicture(maps[h].ncc[0], image)(box),
-                                     NccPicture(maps[h].ncc[1], image)(box)},
+    cv::hconcat(std::vector<cv::Mat>{image(box), view.warped[kHeldOutCoarse](box),
+                                     view.warped[kHeldOutRefined](box),
+                                     NccPicture(view.ncc[kHeldOutCoarse], image)(box),
+                                     NccPicture(view.ncc[kHeldOutRefined], image)(box)},
                 picture);
     const std::string path =
         eval_dir + "/heldout_" + frame_name + "_" + held_out[h].camera.name + ".png";
@@ -98,8 +124,8 @@ HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_camer
 }
 
 std::vector<SurfaceScore> PooledHeldOutScore(const std::vector<HeldOutFrame>& frames) {
-  std::vector<SurfaceScore> pooled(2, SurfaceScore{std::nan(""), std::nan("")});
-  for (int s = 0; s < 2; ++s) {
+  std::vector<SurfaceScore> pooled(kNumHeldOutSurfaces, SurfaceScore{std::nan(""), std::nan("")});
+  for (int s = 0; s < kNumHeldOutSurfaces; ++s) {
     double ncc = 0.0, mad = 0.0;
     int ncc_count = 0, mad_count = 0;
     for (const HeldOutFrame& frame : frames) {
@@ -115,16 +141,12 @@ std::vector<SurfaceScore> PooledHeldOutScore(const std::vector<HeldOutFrame>& fr
 }
 
 std::string HeldOutPooledJson(const std::vector<HeldOutFrame>& frames, const std::string& indent) {
-  const std::vector<SurfaceScore> pooled = PooledHeldOutScore(frames);
-  return "\"heldout_ncc_input\": " + JsonNumber(pooled[0].ncc) + "," + indent +
-         "\"heldout_ncc_refined\": " + JsonNumber(pooled[1].ncc) + "," + indent +
-         "\"heldout_mad_input\": " + JsonNumber(pooled[0].mad) + "," + indent +
-         "\"heldout_mad_refined\": " + JsonNumber(pooled[1].mad);
+  return SurfaceJson(PooledHeldOutScore(frames), "heldout_", indent);
 }
 
 std::string HeldOutFrameJson(const HeldOutFrame& frame) {
   std::ostringstream json;
-  json << "{" << SurfaceJson(frame.score.mean) << ", \"views\": [";
+  json << "{" << SurfaceJson(frame.score.mean, "", " ") << ", \"views\": [";
   for (size_t h = 0; h < frame.score.views.size(); ++h) {
     const HeldOutViewScore& view = frame.score.views[h];
     json << (h == 0 ? "" : ", ") << "{\"camera\": " << JsonString(view.camera)
@@ -132,7 +154,7 @@ std::string HeldOutFrameJson(const HeldOutFrame& frame) {
     for (size_t t = 0; t < view.training.size(); ++t) {
       json << (t == 0 ? "" : ", ") << JsonString(view.training[t]);
     }
-    json << "], " << SurfaceJson(view.surfaces) << ", \"ncc_pixels\": " << view.ncc_pixels
+    json << "], " << SurfaceJson(view.surfaces, "", " ") << ", \"ncc_pixels\": " << view.ncc_pixels
          << ", \"common_pixels\": " << view.common_pixels << "}";
   }
   json << "]}";
@@ -144,9 +166,10 @@ void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOpt
   report->AddSection("Held-out cameras");
   std::ostringstream text;
   text << "Each held-out image against the " << options.neighbours
-       << " nearest training views warped into it through the input and through the refined "
-          "mesh (z-buffered: points a training view does not see are left out), over the "
-          "pixels both meshes cover: local normalised cross-correlation of grey levels in "
+       << " nearest training views warped into it through the input as given (the coarse mesh), "
+          "through its subdivision and through the refined mesh (z-buffered: points a training "
+          "view does not see are left out), over the pixels all three cover: local normalised "
+          "cross-correlation of grey levels in "
        << options.window << "x" << options.window
        << " windows (higher is better; windows of the held-out image with a standard deviation "
           "below "
@@ -165,7 +188,8 @@ void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOpt
           ScoreRow("frame " + frame.frame + ", " + view.camera, training, view.surfaces));
     }
   }
-  report->AddTable({"", "training views", "NCC input", "NCC refined", "MAD input", "MAD refined"},
+  report->AddTable({"", "training views", "NCC input", "NCC subdivided", "NCC refined", "MAD input",
+                    "MAD subdivided", "MAD refined"},
                    rows, "Held-out photo-consistency, pooled, per frame and per held-out view");
 }
 

@@ -14,23 +14,28 @@
 namespace finecap {
 namespace internal {
 
-// The held-out score of one frame: surface 0 is the subdivided input mesh, surface 1 the refined
-// mesh as written.
+// The surfaces of a held-out score, in order: the coarse mesh as given (the input its user gave),
+// its subdivision (where refinement starts) and the refined mesh as written.
+enum HeldOutSurface { kHeldOutCoarse = 0, kHeldOutSubdivided = 1, kHeldOutRefined = 2 };
+constexpr int kNumHeldOutSurfaces = 3;
+
+// The held-out score of one frame, its surfaces as HeldOutSurface numbers them.
 struct HeldOutFrame {
   std::string frame;
   HeldOutScore score;
 };
 
-// Scores `input` and `refined` in the views of `frame` named in `held_out_cameras` (training
-// views: the rest of `frame`), writes one picture per held-out view to
+// Scores `coarse` (the frame's coarse mesh as given), `input` (its subdivision) and `refined` in
+// the views of `frame` named in `held_out_cameras` (training views: the rest of `frame`), writes
+// one picture per held-out view (the input as given beside the refined mesh) to
 // eval_dir/heldout_<frame>_<camera>.png and appends its path and caption to `*pictures`.
 HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
                                   const HeldOutOptions& options, const std::string& frame_name,
-                                  FrameInput frame, const Mesh& input, const Mesh& refined,
-                                  const std::string& eval_dir,
+                                  FrameInput frame, const Mesh& coarse, const Mesh& input,
+                                  const Mesh& refined, const std::string& eval_dir,
                                   std::vector<std::pair<std::string, std::string>>* pictures);
 
-// The means over every frame's held-out views, per surface (input, refined).
+// The means over every frame's held-out views, per surface (HeldOutSurface).
 std::vector<SurfaceScore> PooledHeldOutScore(const std::vector<HeldOutFrame>& frames);
 
 // JSON members for metrics.json: the pooled figures ("heldout_ncc_input", ...) and, per frame,

@@ -191,10 +191,13 @@ void EvaluateFrame(const RefinedFrame& frame, const RunEvaluationOptions& option
   const Mesh input = model.Subdivide(coarse);
   const Mesh refined = ReadMesh(frame.files.mesh);
   const Eigen::VectorXd k = ReadDisplacement(frame.files.displacement, input.num_vertices());
-  Eigen::VectorXd k_true = TrueFineDisplacement(*capture, model, coarse, frame.index);
-  if (k_true.size() == 0) k_true = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
+  FineGroundTruth truth = TrueFineGroundTruth(*capture, model, coarse, frame.index);
+  if (truth.empty()) {
+    truth.k_true = truth.coarse_error = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
+  }
   const EvaluationSamples samples = MakeEvaluationSamples(
-      input, refined, k, k_true, model.refined_vertices(), textureless, frame.files.mesh);
+      model.Interpolate(coarse), input, refined, k, truth.k_true, truth.coarse_error,
+      model.refined_vertices(), textureless, frame.files.mesh);
   const EvaluationFigures figures = ComputeEvaluationFigures(samples);
   run->names.push_back(frame.name);
   run->frame_indices.push_back(frame.index);
@@ -208,7 +211,7 @@ void EvaluateFrame(const RefinedFrame& frame, const RunEvaluationOptions& option
   if (!options.held_out_cameras.empty()) {
     run->heldout.push_back(internal::EvaluateHeldOutFrame(
         options.held_out_cameras, options.held_out_score, frame.name,
-        ReadFrameInput(capture, frame.index), input, refined, eval_dir, &run->pictures));
+        ReadFrameInput(capture, frame.index), coarse, input, refined, eval_dir, &run->pictures));
   }
   const Camera& camera = capture->cameras()[options.camera];
   const cv::Mat image = capture->ReadImage(options.camera, frame.index);
@@ -241,13 +244,17 @@ std::string RegionJson(const RegionFigures& region) {
   std::ostringstream json;
   json << "{\"vertices\": " << region.refined.count
        << ", \"rms_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.rms))
+       << ", \"rms_subdivided_mm\": " << JsonNumber(Millimetres(region.subdivided.rms))
        << ", \"rms_refined_mm\": " << JsonNumber(Millimetres(region.refined.rms))
        << ", \"mean_abs_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.mean_abs))
+       << ", \"mean_abs_subdivided_mm\": " << JsonNumber(Millimetres(region.subdivided.mean_abs))
        << ", \"mean_abs_refined_mm\": " << JsonNumber(Millimetres(region.refined.mean_abs))
        << ", \"p95_abs_coarse_mm\": " << JsonNumber(Millimetres(region.coarse.p95_abs))
+       << ", \"p95_abs_subdivided_mm\": " << JsonNumber(Millimetres(region.subdivided.p95_abs))
        << ", \"p95_abs_refined_mm\": " << JsonNumber(Millimetres(region.refined.p95_abs))
        << ", \"detail_recovered\": " << JsonNumber(region.detail_recovered)
        << ", \"normal_error_coarse_deg\": " << JsonNumber(region.normal_error_coarse_deg)
+       << ", \"normal_error_subdivided_deg\": " << JsonNumber(region.normal_error_subdivided_deg)
        << ", \"normal_error_refined_deg\": " << JsonNumber(region.normal_error_refined_deg) << "}";
   return json.str();
 }
@@ -274,9 +281,11 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
   const RegionFigures& all = sequence.all;
   std::ostringstream json;
   json << "{\n  \"rms_coarse_mm\": " << JsonNumber(Millimetres(all.coarse.rms))
+       << ",\n  \"rms_subdivided_mm\": " << JsonNumber(Millimetres(all.subdivided.rms))
        << ",\n  \"rms_refined_mm\": " << JsonNumber(Millimetres(all.refined.rms))
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
+       << ",\n  \"normal_error_subdivided_deg\": " << JsonNumber(all.normal_error_subdivided_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
        << ",\n  " << FlowJson(run.pooled_flow, "\n  ") << ",\n  \"flow_refined_texture\": "
        << (run.refined_flow_texture
@@ -335,11 +344,17 @@ std::vector<std::pair<std::string, std::string>> WritePlots(const EvaluationRun&
   const std::vector<PlotSeries> rms = {
       SeriesOverFrames("input", run,
                        [](const EvaluationFigures& f) { return Millimetres(f.all.coarse.rms); }),
+      SeriesOverFrames(
+          "subdivided", run,
+          [](const EvaluationFigures& f) { return Millimetres(f.all.subdivided.rms); }),
       SeriesOverFrames("refined", run,
                        [](const EvaluationFigures& f) { return Millimetres(f.all.refined.rms); })};
   const std::vector<PlotSeries> normals = {
       SeriesOverFrames("input", run,
                        [](const EvaluationFigures& f) { return f.all.normal_error_coarse_deg; }),
+      SeriesOverFrames(
+          "subdivided", run,
+          [](const EvaluationFigures& f) { return f.all.normal_error_subdivided_deg; }),
       SeriesOverFrames("refined", run,
                        [](const EvaluationFigures& f) { return f.all.normal_error_refined_deg; })};
   if (!AnyFinite(rms[0])) return {};
@@ -359,6 +374,7 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
   return {name,
           region.refined.count,
           Millimetres(region.coarse.rms),
+          Millimetres(region.subdivided.rms),
           Millimetres(region.refined.rms),
           Millimetres(region.coarse.mean_abs),
           Millimetres(region.refined.mean_abs),
@@ -366,6 +382,7 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
           Millimetres(region.refined.p95_abs),
           100.0 * region.detail_recovered,
           region.normal_error_coarse_deg,
+          region.normal_error_subdivided_deg,
           region.normal_error_refined_deg};
 }
 
@@ -442,6 +459,7 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
   const std::vector<std::string> header = {"",
                                            "vertices",
                                            "RMS input mm",
+                                           "RMS subdivided mm",
                                            "RMS refined mm",
                                            "mean input mm",
                                            "mean refined mm",
@@ -449,13 +467,17 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                                            "p95 refined mm",
                                            "detail recovered %",
                                            "normal error input deg",
+                                           "normal error subdivided deg",
                                            "normal error refined deg"};
   HtmlReport report("finecap evaluation");
   report.AddSection("Figures");
   report.AddParagraph(
-      "Errors of the displacement k along the normals of the subdivided input mesh against the "
-      "ground truth, over the refined vertices (input = k of 0). True normals: the input mesh "
-      "displaced by the true k. n/a: no ground truth or an empty region.");
+      "Distances to the ground truth along the normals of the subdivided input mesh, over the "
+      "refined vertices, of the input as given (the coarse mesh's triangles sampled at the fine "
+      "vertices), of its Loop subdivision (where refinement starts, k of 0) and of the refined "
+      "mesh (k - k_true). Detail recovered: 1 - RMS refined / RMS input, against the input as "
+      "given. True normals: the subdivided input mesh displaced by the true k. n/a: no ground "
+      "truth or an empty region.");
   report.AddTable(header,
                   {TableRow("all", sequence.all), TableRow("textured", sequence.textured),
                    TableRow("textureless", sequence.textureless)},

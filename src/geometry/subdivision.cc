@@ -350,6 +350,14 @@ void RequireIdsFit(const Mesh& coarse, int levels, const std::string& where) {
           std::to_string(levels) + " subdivision levels would make more vertices than ids allow");
 }
 
+void RequireCoarseVertices(const SubdivisionStencil& stencil,
+                           const Eigen::Matrix3Xd& coarse_vertices, const std::string& where) {
+  Require(coarse_vertices.cols() == stencil.num_coarse_vertices, where,
+          "the frame has " + std::to_string(coarse_vertices.cols()) +
+              " vertices but the subdivision was built for " +
+              std::to_string(stencil.num_coarse_vertices));
+}
+
 }  // namespace
 
 int SubdivisionStencil::FineVertexOfCoarse(int coarse_vertex) const {
@@ -409,12 +417,27 @@ SubdivisionStencil BuildLinearSubdivision(const Mesh& coarse, int levels,
 
 Mesh ApplySubdivision(const SubdivisionStencil& stencil, const Eigen::Matrix3Xd& coarse_vertices,
                       const std::string& where) {
-  Require(coarse_vertices.cols() == stencil.num_coarse_vertices, where,
-          "the frame has " + std::to_string(coarse_vertices.cols()) +
-              " vertices but the subdivision was built for " +
-              std::to_string(stencil.num_coarse_vertices));
+  RequireCoarseVertices(stencil, coarse_vertices, where);
   Mesh fine;
   fine.vertices = coarse_vertices * stencil.matrix.transpose();
+  fine.faces = stencil.faces;
+  return fine;
+}
+
+Mesh ApplyLinearSubdivision(const SubdivisionStencil& stencil,
+                            const Eigen::Matrix3Xd& coarse_vertices, const std::string& where) {
+  RequireCoarseVertices(stencil, coarse_vertices, where);
+  Mesh fine;
+  fine.vertices.resize(3, stencil.num_fine_vertices());
+  fine.vertices.leftCols(coarse_vertices.cols()) = coarse_vertices;
+  // Edge points follow their parents in the numbering, so each level reads only what is set.
+  Eigen::Index next = coarse_vertices.cols();
+  for (const Eigen::Matrix2Xi& edges : stencil.level_edges) {
+    for (int e = 0; e < edges.cols(); ++e, ++next) {
+      fine.vertices.col(next) =
+          0.5 * (fine.vertices.col(edges(0, e)) + fine.vertices.col(edges(1, e)));
+    }
+  }
   fine.faces = stencil.faces;
   return fine;
 }

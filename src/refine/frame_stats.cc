@@ -55,8 +55,9 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.worse = result.worse;
   stats.kept_input = result.kept_input;
   stats.prepared_ahead = result.prepared_ahead;
-  stats.rms_coarse_mm = stats.rms_refined_mm = std::nan("");
-  stats.rms_textureless_coarse_mm = stats.rms_textureless_refined_mm = std::nan("");
+  stats.rms_coarse_mm = stats.rms_subdivided_mm = stats.rms_refined_mm = std::nan("");
+  stats.rms_textureless_coarse_mm = stats.rms_textureless_subdivided_mm =
+      stats.rms_textureless_refined_mm = std::nan("");
   stats.peak_rss_mb = PeakResidentMegabytes();
   return stats;
 }
@@ -85,12 +86,16 @@ std::string ToJson(const FrameStats& s) {
        << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
        << ", \"prepared_ahead\": " << (s.prepared_ahead ? "true" : "false")
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
+       << ", \"rms_subdivided_mm\": " << JsonNumber(s.rms_subdivided_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
+       << ", \"rms_textureless_subdivided_mm\": " << JsonNumber(s.rms_textureless_subdivided_mm)
        << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
        << ", \"heldout_ncc_input\": " << JsonNumber(s.heldout_ncc_input)
+       << ", \"heldout_ncc_subdivided\": " << JsonNumber(s.heldout_ncc_subdivided)
        << ", \"heldout_ncc_refined\": " << JsonNumber(s.heldout_ncc_refined)
        << ", \"heldout_mad_input\": " << JsonNumber(s.heldout_mad_input)
+       << ", \"heldout_mad_subdivided\": " << JsonNumber(s.heldout_mad_subdivided)
        << ", \"heldout_mad_refined\": " << JsonNumber(s.heldout_mad_refined)
        << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << ", \"skipped_cameras\": [";
   for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
@@ -125,12 +130,16 @@ struct StatsFields {
       {"seconds_heldout", &FrameStats::seconds_heldout},
       {"cpu_seconds", &FrameStats::cpu_seconds},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
+      {"rms_subdivided_mm", &FrameStats::rms_subdivided_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
+      {"rms_textureless_subdivided_mm", &FrameStats::rms_textureless_subdivided_mm},
       {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm},
       {"heldout_ncc_input", &FrameStats::heldout_ncc_input},
+      {"heldout_ncc_subdivided", &FrameStats::heldout_ncc_subdivided},
       {"heldout_ncc_refined", &FrameStats::heldout_ncc_refined},
       {"heldout_mad_input", &FrameStats::heldout_mad_input},
+      {"heldout_mad_subdivided", &FrameStats::heldout_mad_subdivided},
       {"heldout_mad_refined", &FrameStats::heldout_mad_refined},
       {"peak_rss_mb", &FrameStats::peak_rss_mb}};
   std::vector<std::pair<const char*, int FrameStats::*>> ints = {

@@ -95,6 +95,10 @@ Mesh SequenceModel::Subdivide(const Mesh& coarse) const {
   return ApplySubdivision(stencil_, coarse.vertices);
 }
 
+Mesh SequenceModel::Interpolate(const Mesh& coarse) const {
+  return ApplyLinearSubdivision(stencil_, coarse.vertices);
+}
+
 std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
                                                                const Eigen::Matrix3Xd& normals,
                                                                const std::vector<Camera>& cameras,

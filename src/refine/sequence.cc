@@ -110,37 +110,45 @@ Regions SplitByTexture(const SequenceModel& model, const Capture& capture) {
   return regions;
 }
 
-// `truth`: the frame's TrueFineDisplacement (empty: none).
-void AddGroundTruthErrors(const Eigen::VectorXd& truth, const Regions& regions,
+// The errors of the coarse mesh as given, of its subdivision and of the result against `truth`
+// (the frame's TrueFineGroundTruth; empty: none), into `stats`.
+void AddGroundTruthErrors(const FineGroundTruth& truth, const Regions& regions,
                           const FrameResult& result, FrameStats* stats) {
-  if (truth.size() == 0) return;
-  // Only where the result has a displacement: both figures over the same vertices.
-  const Eigen::VectorXd input = result.k.array().isFinite().select(0.0 * result.k, result.k);
-  stats->rms_coarse_mm = 1000.0 * ComputeErrorStats(input, truth, regions.textured).rms;
-  stats->rms_refined_mm = 1000.0 * ComputeErrorStats(result.k, truth, regions.textured).rms;
-  stats->rms_textureless_coarse_mm =
-      1000.0 * ComputeErrorStats(input, truth, regions.textureless).rms;
-  stats->rms_textureless_refined_mm =
-      1000.0 * ComputeErrorStats(result.k, truth, regions.textureless).rms;
+  if (truth.empty()) return;
+  // Only where the result has a displacement: every figure over the same vertices.
+  const Eigen::VectorXd zero = result.k.array().isFinite().select(0.0 * result.k, result.k);
+  const auto rms_mm = [](const Eigen::VectorXd& estimate, const Eigen::VectorXd& truth,
+                         const std::vector<int>& region) {
+    return 1000.0 * ComputeErrorStats(estimate, truth, region).rms;
+  };
+  stats->rms_coarse_mm = rms_mm(zero, truth.coarse_error, regions.textured);
+  stats->rms_subdivided_mm = rms_mm(zero, truth.k_true, regions.textured);
+  stats->rms_refined_mm = rms_mm(result.k, truth.k_true, regions.textured);
+  stats->rms_textureless_coarse_mm = rms_mm(zero, truth.coarse_error, regions.textureless);
+  stats->rms_textureless_subdivided_mm = rms_mm(zero, truth.k_true, regions.textureless);
+  stats->rms_textureless_refined_mm = rms_mm(result.k, truth.k_true, regions.textureless);
 }
 
-// The held-out score of the frame's input and of its result (as solved), into `stats`; a result
-// whose held-out NCC is below the input's is flagged worse and, with keep_input_if_worse,
-// replaced by the input.
+// The held-out score of the frame's coarse mesh as given, of its subdivision and of its result
+// (as solved), into `stats`; a result whose held-out NCC is below the input's as given is
+// flagged worse and, with keep_input_if_worse, replaced by the subdivided input.
 void ScoreInHeldOutViews(const SequenceOptions& options, const SequenceModel& model,
                          const FrameInput& input, const std::vector<CalibratedImage>& held_out,
                          FrameResult* result, FrameStats* stats) {
   if (held_out.empty()) return;
   const auto start = std::chrono::steady_clock::now();
   const Mesh fine_input = model.Subdivide(input.coarse);
-  const HeldOutScore score = ScoreHeldOutViews(
-      CalibratedImagesOf(input), held_out, {&fine_input, &result->refined}, options.held_out_score);
+  const HeldOutScore score =
+      ScoreHeldOutViews(CalibratedImagesOf(input), held_out,
+                        {&input.coarse, &fine_input, &result->refined}, options.held_out_score);
   stats->heldout_ncc_input = score.mean[0].ncc;
-  stats->heldout_ncc_refined = score.mean[1].ncc;
+  stats->heldout_ncc_subdivided = score.mean[1].ncc;
+  stats->heldout_ncc_refined = score.mean[2].ncc;
   stats->heldout_mad_input = score.mean[0].mad;
-  stats->heldout_mad_refined = score.mean[1].mad;
+  stats->heldout_mad_subdivided = score.mean[1].mad;
+  stats->heldout_mad_refined = score.mean[2].mad;
   stats->seconds_heldout = SecondsSince(start);
-  if (!(score.mean[1].ncc < score.mean[0].ncc)) return;
+  if (!(score.mean[2].ncc < score.mean[0].ncc)) return;
   result->worse = stats->worse = true;
   if (options.refine.keep_input_if_worse && !result->kept_input) {
     KeepInputSurface(fine_input, result);
@@ -200,7 +208,7 @@ class SequenceRun {
     if (!FollowsColors(options_)) RequireNoFollowedColors();
     ReportProblemSize(frames);
     prepare_ahead_ = !FollowsColors(options_);
-    double sum_coarse2 = 0.0, sum_refined2 = 0.0;
+    double sum_coarse2 = 0.0, sum_subdivided2 = 0.0, sum_refined2 = 0.0;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
       if (Done(frame)) {
         observer_->FrameAlreadyDone(capture_->frame_name(frame));
@@ -211,12 +219,14 @@ class SequenceRun {
       ++result->refined;
       if (std::isfinite(stats.rms_refined_mm)) {
         sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
+        sum_subdivided2 += stats.rms_subdivided_mm * stats.rms_subdivided_mm;
         sum_refined2 += stats.rms_refined_mm * stats.rms_refined_mm;
         ++result->measured;
       }
       observer_->FrameRefined(stats);
     }
     result->rms_coarse_mm = std::sqrt(sum_coarse2 / result->measured);
+    result->rms_subdivided_mm = std::sqrt(sum_subdivided2 / result->measured);
     result->rms_refined_mm = std::sqrt(sum_refined2 / result->measured);
   }
 
@@ -303,7 +313,7 @@ class SequenceRun {
   void WorkAhead(int frame, FrameReadAhead::Frame* read) const {
     // The truth first: building its ray caster runs on one thread, and while the frame before is
     // still being solved that leaves no core idle; last, it would when that solve ends first.
-    read->true_displacement = TrueFineDisplacement(*capture_, model_, read->input.coarse, frame);
+    read->truth = TrueFineGroundTruth(*capture_, model_, read->input.coarse, frame);
     if (prepare_ahead_) {
       read->prepared = PrepareFrameAhead(model_, reference_colors_, &read->input, options_.refine);
       // Beside the refinement only the held-out score reads the pixels after this: two frames'
@@ -360,7 +370,7 @@ class SequenceRun {
     FrameStats stats = MakeFrameStats(name, options_.refine, result);
     for (const SkippedCamera& camera : skipped) stats.skipped_cameras.push_back(camera.camera);
     ScoreInHeldOutViews(options_, model_, input, held_out, &result, &stats);
-    AddGroundTruthErrors(read.true_displacement, regions_, result, &stats);
+    AddGroundTruthErrors(read.truth, regions_, result, &stats);
     // Before the record, which marks the frame done: a done frame always has them.
     if (FollowsColors(options_) && frame >= options_.reference_frame) {
       SaveFollowedColors(name, colors, input, result, stats.worse);
@@ -506,12 +516,19 @@ ReferenceColors SaveReferenceColors(const SequenceModel& model, const SequenceOp
   return ReadReferenceColors(path, model.num_fine_vertices());
 }
 
-Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
-                                     const Mesh& coarse, int frame) {
+FineGroundTruth TrueFineGroundTruth(const Capture& capture, const SequenceModel& model,
+                                    const Mesh& coarse, int frame) {
   if (!capture.HasTrueSurface(frame)) return {};
   const Mesh fine = model.Subdivide(coarse);
-  return TrueDisplacementAlongNormals(fine.vertices, ComputeVertexNormals(fine),
-                                      capture.ReadTrueSurface(frame), 0.1);
+  const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
+  const Eigen::Index n = fine.num_vertices();
+  // Both point sets in one cast: the truth's ray caster is built once.
+  Eigen::Matrix3Xd points(3, 2 * n), directions(3, 2 * n);
+  points << fine.vertices, model.Interpolate(coarse).vertices;
+  directions << normals, normals;
+  const Eigen::VectorXd distances =
+      TrueDisplacementAlongNormals(points, directions, capture.ReadTrueSurface(frame), 0.1);
+  return {distances.head(n), distances.tail(n)};
 }
 
 Eigen::VectorXd ReadSolvedDisplacement(const FrameFiles& files, int num_fine_vertices,

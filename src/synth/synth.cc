@@ -133,9 +133,9 @@ Eigen::VectorXd CastAlongNormals(const Mesh& coarse, const Mesh& truth, double m
   return k;
 }
 
-// The coarse input of a frame before misalignment (see CoarseInput). Smoothed: the true surface
-// at the coarse vertices, which are vertices of the true mesh displaced by their fold along their
-// smooth normal, then smoothed over the coarse mesh.
+// The coarse input of a frame before misalignment (see CoarseInput). Exact: the true surface at
+// the coarse vertices, which are vertices of the true mesh displaced by their fold along their
+// smooth normal; smoothed: that, smoothed over the coarse mesh.
 Eigen::Matrix3Xd CoarseInputVertices(const SynthOptions& options, const Subject& subject,
                                      const synth_internal::SmoothFrame& smooth,
                                      const Eigen::VectorXd& folds_at_coarse) {
@@ -143,6 +143,7 @@ Eigen::Matrix3Xd CoarseInputVertices(const SynthOptions& options, const Subject&
   Mesh detailed;
   detailed.faces = subject.coarse_faces;
   detailed.vertices = smooth.coarse_vertices + smooth.coarse_normals * folds_at_coarse.asDiagonal();
+  if (options.coarse == CoarseInput::kExact) return detailed.vertices;
   return TaubinSmooth(detailed, options.smoothing);
 }
 

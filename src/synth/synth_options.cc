@@ -42,7 +42,8 @@ const std::vector<EnumName<SynthSubject>>& EnumNames(SynthSubject) {
 
 const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput) {
   static const std::vector<EnumName<CoarseInput>> names = {{CoarseInput::kUnfolded, "unfolded"},
-                                                           {CoarseInput::kSmoothed, "smoothed"}};
+                                                           {CoarseInput::kSmoothed, "smoothed"},
+                                                           {CoarseInput::kExact, "exact"}};
   return names;
 }
 

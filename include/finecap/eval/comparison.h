@@ -22,7 +22,7 @@ struct VariantSummary {
   double energy_end = 0.0;          // E of the variant's own energy at its result.
   double paper_similarity = 0.0;    // The paper's E_sim at the result; NaN when not measured.
   double ls_cost_end = 0.0;         // 1/2 sum of squared residuals of the least-squares form.
-  double rms_input_mm = 0.0;        // Textured region, the input (k = 0); NaN without truth.
+  double rms_input_mm = 0.0;        // Textured region, the input mesh as given; NaN without truth.
   double rms_textured_mm = 0.0;     // Textured region, the result.
   double rms_textureless_mm = 0.0;  // Textureless region, the result; NaN when there is none.
   double detail_recovered = 0.0;    // 1 - rms_textured_mm / rms_input_mm (metrics.h).

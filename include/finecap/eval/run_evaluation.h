@@ -68,9 +68,11 @@ struct RunEvaluation {
   bool flow_measured = false;
   // What textured the refined mesh for the flow, when measured.
   RefinedFlowTexture refined_flow_texture = RefinedFlowTexture::kInputReferenceMesh;
-  FlowComparison flow;                // Pooled over the frames and cameras.
-  std::vector<SurfaceScore> heldout;  // Input, refined; empty without held-out cameras.
-  std::string report, metrics;        // report.html and metrics.json.
+  FlowComparison flow;  // Pooled over the frames and cameras.
+  // In the held-out cameras, pooled: the coarse mesh as given (the input), its subdivision and
+  // the refined mesh, in that order; empty without held-out cameras.
+  std::vector<SurfaceScore> heldout;
+  std::string report, metrics;  // report.html and metrics.json.
 };
 
 // Evaluates `frames` of `capture` (the done frames of a run folder: FindRefinedFrames) into

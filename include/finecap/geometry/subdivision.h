@@ -107,6 +107,16 @@ SubdivisionStencil BuildLinearSubdivision(const Mesh& coarse, int levels,
 Mesh ApplySubdivision(const SubdivisionStencil& stencil, const Eigen::Matrix3Xd& coarse_vertices,
                       const std::string& where = "subdivision");
 
+// The coarse surface as given, sampled at the fine vertices of `stencil`: every edge point at
+// the midpoint of its two parents, level by level (midpoint subdivision, with the stencil's
+// numbering and faces). Every fine vertex is then the linear interpolation of the corners of its
+// coarse triangle, and the fine mesh is the coarse one face for face, where Loop's rules would
+// smooth it. What measures a coarse mesh as its user gave it against a finer truth. Throws
+// Error(where, ...) as ApplySubdivision does.
+Mesh ApplyLinearSubdivision(const SubdivisionStencil& stencil,
+                            const Eigen::Matrix3Xd& coarse_vertices,
+                            const std::string& where = "subdivision");
+
 // Carries a per-vertex mask (e.g. the vertices to refine) to the fine mesh: a coarse vertex keeps
 // its flag and an edge point is in the mask exactly when both of its parents are, level by level.
 // Throws Error(where, ...) when the mask has not num_coarse_vertices entries; `where` names the

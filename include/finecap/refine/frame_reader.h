@@ -58,9 +58,9 @@ class FrameReadAhead {
     std::vector<SkippedCamera> skipped;     // Cameras whose image could not be read.
     // Filled by `work_ahead`, when it does: the frame prepared for its solve (which takes the
     // input's image models, and may leave the input without its images when nothing else reads
-    // them), and the true displacement of its fine vertices (a synthetic capture's ground truth).
+    // them), and the ground truth at its fine vertices (a synthetic capture's).
     PreparedFrame prepared;
-    Eigen::VectorXd true_displacement;
+    FineGroundTruth truth;
   };
   // Work on frame `frame` once it is read, on the reader's thread (or the caller's, for a frame
   // Take reads itself), with as many OpenMP threads as the thread that made the reader had.

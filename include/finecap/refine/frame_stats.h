@@ -44,21 +44,27 @@ struct FrameStats {
   bool kept_input = false;  // And the input surface was written instead.
   bool prepared_ahead = false;  // PrepareFrameAhead, with the plane sweep, while another frame
                                 // was solved.
-  // Against ground truth, when the capture has it (NaN otherwise): RMS of k - k_true over the
-  // refined vertices of the textured region, for the input (k = 0) and the result, millimetres.
+  // Against ground truth, when the capture has it (NaN otherwise): RMS error over the refined
+  // vertices of the textured region, millimetres (FineGroundTruth), of the coarse mesh as given
+  // (the input as its user gave it, its triangles sampled at the fine vertices), of its
+  // subdivision (k = 0, where the refinement starts) and of the result (k - k_true).
   double rms_coarse_mm = 0.0;
+  double rms_subdivided_mm = 0.0;
   double rms_refined_mm = 0.0;
   // The same over the textureless region (NaN when the capture marks none).
   double rms_textureless_coarse_mm = 0.0;
+  double rms_textureless_subdivided_mm = 0.0;
   double rms_textureless_refined_mm = 0.0;
   // In the held-out cameras (validation.cameras; heldout_score.h), NaN when there are none: the
   // mean local NCC and mean absolute grey-level difference between each held-out image and the
-  // training views warped into it through the subdivided input mesh and through the refined
-  // mesh as solved (before refine.keep_input_if_worse puts the input back). A refined NCC below
-  // the input's flags the frame `worse`.
+  // training views warped into it through the coarse mesh as given (input), through its
+  // subdivision and through the refined mesh as solved (before refine.keep_input_if_worse puts
+  // the subdivided input back). A refined NCC below the input's flags the frame `worse`.
   double heldout_ncc_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_ncc_subdivided = std::numeric_limits<double>::quiet_NaN();
   double heldout_ncc_refined = std::numeric_limits<double>::quiet_NaN();
   double heldout_mad_input = std::numeric_limits<double>::quiet_NaN();
+  double heldout_mad_subdivided = std::numeric_limits<double>::quiet_NaN();
   double heldout_mad_refined = std::numeric_limits<double>::quiet_NaN();
   // Cameras left out of this frame because their image could not be read
   // (capture.skip_unreadable_cameras); empty when every camera was used.

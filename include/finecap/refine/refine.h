@@ -149,6 +149,9 @@ class SequenceModel {
 
   // The subdivided mesh of a frame and its area-weighted unit normals.
   Mesh Subdivide(const Mesh& coarse) const;
+  // The coarse mesh of a frame as given, at the same fine vertices (ApplyLinearSubdivision): the
+  // user's surface, which the baselines of an evaluation are measured on.
+  Mesh Interpolate(const Mesh& coarse) const;
   int num_fine_vertices() const { return stencil_.num_fine_vertices(); }
   // Fine vertex ids to refine: the subdivided mask (all when there is none). Those that no camera
   // saw in the reference frame get no surface Gaussian.
@@ -163,6 +166,21 @@ class SequenceModel {
   int num_coarse_vertices_ = 0;
   std::vector<int> refined_vertices_;
   VertexNeighbourhoods neighbourhoods_;
+};
+
+// The ground truth of a frame at the fine vertices, measured along the unit normals of its
+// subdivided mesh (the lines the refinement moves the vertices on). Both vectors are empty when
+// the capture has no true surface for the frame.
+struct FineGroundTruth {
+  // Per fine vertex: the signed distance from the subdivided mesh to the true surface, the true
+  // k; NaN where the line misses it.
+  Eigen::VectorXd k_true;
+  // Per fine vertex: the signed distance from the coarse mesh as given, at the vertex
+  // (SequenceModel::Interpolate), along the same normal to the true surface; NaN on a miss. The
+  // error of the input as its user gave it, which subdivision may lessen or add to.
+  Eigen::VectorXd coarse_error;
+
+  bool empty() const { return k_true.size() == 0; }
 };
 
 // For each camera, which fine vertices of `mesh` (with `normals`) it sees.

@@ -141,10 +141,10 @@ ReferenceColors SaveReferenceColors(const SequenceModel& model, const SequenceOp
                                     Capture* capture, const FrameInput& reference,
                                     const std::string& path);
 
-// The true displacement of every fine vertex along its normal (NaN where unknown), or an empty
-// vector when the capture has no true surface for the frame.
-Eigen::VectorXd TrueFineDisplacement(const Capture& capture, const SequenceModel& model,
-                                     const Mesh& coarse, int frame);
+// The FineGroundTruth (refine.h) of `frame`, whose coarse mesh is `coarse`: empty when the capture
+// has no true surface for it.
+FineGroundTruth TrueFineGroundTruth(const Capture& capture, const SequenceModel& model,
+                                    const Mesh& coarse, int frame);
 
 // Where a done frame's solve ended, per fine vertex (SolvedDisplacement of its saved
 // displacement, kept_input read from its record): what seeds the next frame with warm start.
@@ -177,9 +177,11 @@ struct SequenceResult {
   int refined = 0;       // Frames refined by this call.
   int already_done = 0;  // Frames found done and skipped.
   // Over the frames refined now that have ground truth (`measured` of them): the root mean square
-  // of their per-frame RMS errors (textured region), input and refined, millimetres; NaN when none.
+  // of their per-frame RMS errors (textured region) of the coarse mesh as given, of its
+  // subdivision and of the result, millimetres (FrameStats); NaN when none.
   int measured = 0;
   double rms_coarse_mm = 0.0;
+  double rms_subdivided_mm = 0.0;
   double rms_refined_mm = 0.0;
 };
 

@@ -7,8 +7,9 @@
 //
 //   cameras.yaml                  the rig as calibrated (calibration noise applied)
 //   images/<camera>/<frame>.png   8-bit colour images, distorted with the rig's lens distortion
-//   meshes/<frame>.ply            coarse input mesh: the true surface without its folds, or a
-//                                 smoothed copy of it (SynthOptions::coarse)
+//   meshes/<frame>.ply            coarse input mesh: the true surface without its folds, a
+//                                 smoothed copy of it, or the true surface at the coarse
+//                                 vertices (SynthOptions::coarse)
 //   gt/<frame>.ply                the true (finer) surface
 //   gt/<frame>_k.txt              per coarse vertex: signed distance along its (area-weighted)
 //                                 coarse normal to the true surface, metres; "nan" on a miss
@@ -162,8 +163,15 @@ enum class CoarseInput {
   // mesh sequence as the subject (truth_refinement 1, no folds) it is the sequence itself that
   // the coarse meshes smooth.
   kSmoothed,
+  // The true surface at the coarse vertices (each coarse vertex is a vertex of the true mesh,
+  // displaced by its fold), without smoothing: the input is exact at its vertices, and what it
+  // lacks is the detail between them, which a coarse mesh cannot hold. The honest best case of
+  // a coarse input (a tracker exact at its vertices); with a detailed user mesh sequence as the
+  // subject (truth_refinement 1, no folds) it is the sequence itself.
+  kExact,
 };
-const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput);  // unfolded, smoothed.
+// unfolded, smoothed, exact.
+const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput);
 
 // What a synthetic capture shows (SynthOptions::subject): "skirt" (the built-in flared tube) or
 // "mesh" (meshes from files).
@@ -179,7 +187,7 @@ struct SynthOptions {
   // sharing one topology, taken in name order (.ply, .obj, .off, .stl). World y must point up.
   // The true surface is each frame's midpoint subdivision with folds added along interpolated
   // normals (truth_refinement 1 and no folds: the mesh itself); the coarse input is the mesh
-  // itself, or its smoothed copy (see `coarse`). Default empty.
+  // itself, or its smoothed copy (see `coarse`; exact: the mesh itself). Default empty.
   std::string mesh_path;
   // Number of frames (>= 1; at most the number of meshes in a `mesh_path` folder). Default 5.
   int num_frames = 5;
@@ -236,8 +244,8 @@ struct SynthOptions {
 
 // The ground truth of one frame, in memory.
 struct SyntheticFrame {
-  Mesh coarse;  // The input mesh: unfolded or smoothed (SynthOptions::coarse), misaligned when
-                // asked.
+  Mesh coarse;  // The input mesh: unfolded, smoothed or exact (SynthOptions::coarse),
+                // misaligned when asked.
   Mesh truth;   // The true, finer surface.
   // Per coarse vertex: signed distance along its coarse normal to `truth`; NaN on a miss.
   Eigen::VectorXd true_k;

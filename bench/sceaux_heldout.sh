@@ -1,0 +1,123 @@
+#!/usr/bin/env bash
+# Sceaux Castle (the OpenMVS sample: real photos and the mesh a full photogrammetry pipeline made
+# from them, an input that is good already) refined with the default settings and the two views of
+# its heldout.yaml left out, then measured in those views by `finecap eval`: the held-out NCC
+# (7x7 windows, the 4 nearest training views warped in) and MAD of the input mesh as given, of its
+# subdivision (where refinement starts) and of the refined mesh.
+#
+#   bash bench/sceaux_heldout.sh        # CAPTURE=DIR for a copy elsewhere; OUT=DIR keeps the runs
+#   SET="model.subdivision_levels=2" bash bench/sceaux_heldout.sh     # extra settings (--set)
+#   OPENMVS_BIN=DIR bash bench/sceaux_heldout.sh   # also OpenMVS RefineMesh on the same 8 views
+#
+# With OPENMVS_BIN (a folder holding InterfaceCOLMAP and RefineMesh, e.g. from
+# ../shared/tools/build_openmvs.sh) OpenMVS refines the same mesh from the same training views, as
+# ../shared/tools/README.md prescribes: a training copy of the capture without the held-out
+# cameras (a temporary folder of symlinks: nothing is written into the capture) is converted by
+# ../shared/tools/finecap_capture_to_colmap.py, InterfaceCOLMAP imports it, RefineMesh refines the
+# mesh with its topology fixed, and its output is scored as given: as the input mesh of a capture
+# with the held-out cameras, refined with no subdivision, no iteration and no sweep.
+#
+# Prints one "name: value" a line: per held-out view heldout_ncc_input/subdivided/refined and
+# heldout_mad_input/subdivided/refined (input: the mesh as given), the same over both views,
+# refine_worse (the frame's flag), heldout_score_seconds (the score's share of refine),
+# refine_seconds and refine_peak_mb (wall time and peak resident
+# memory of `finecap refine`, /usr/bin/time) and eval_seconds; with OPENMVS_BIN also
+# openmvs_heldout_ncc, openmvs_heldout_mad (its mesh as given, the same views and score),
+# openmvs_seconds (InterfaceCOLMAP and RefineMesh, wall time) and openmvs_peak_mb.
+# Each run scores its surfaces over the pixels all of them cover: the OpenMVS mesh is scored in
+# a run of its own, so its pixels differ a little from those of finecap's three surfaces.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+capture=${CAPTURE:-../shared/captures/openmvs_sceaux}
+if [ ! -f "$capture/cameras.yaml" ] || [ ! -f "$capture/heldout.yaml" ]; then
+  echo "SKIPPED: no Sceaux capture (cameras.yaml and heldout.yaml) at $capture" >&2
+  exit 0
+fi
+capture=$(cd "$capture" && pwd)
+tools=${TOOLS:-$(dirname "$capture")/../tools}
+work=${OUT:-$(mktemp -d)}
+[ -n "${OUT:-}" ] || trap 'rm -rf "$work"' EXIT
+mkdir -p "$work"
+work=$(cd "$work" && pwd)
+rm -rf "$work/run" "$work/openmvs"
+
+[ -x build/finecap ] || bash scripts/build.sh >/dev/null
+# One --set each: of several, finecap keeps the last.
+args=(--config "$capture/heldout.yaml" --capture "$capture" --out "$work/run")
+/usr/bin/time -f "%e %M" -o "$work/refine.time" \
+  build/finecap refine "${args[@]}" --set "${SET:-}" >/dev/null 2>"$work/refine.log"
+start=$(date +%s.%N)
+build/finecap eval "${args[@]}" --set "eval.flow=none${SET:+,$SET}" >/dev/null 2>"$work/eval.log"
+end=$(date +%s.%N)
+
+python3 bench/heldout_figures.py "$work/run"
+read -r seconds kilobytes < "$work/refine.time"
+echo "refine_seconds: $seconds"
+echo "refine_peak_mb: $((kilobytes / 1024))"
+echo "eval_seconds: $(awk -v e="$end" -v s="$start" 'BEGIN { printf "%.1f", e - s }')"
+
+if [ -z "${OPENMVS_BIN:-}" ]; then
+  echo "openmvs: skipped (set OPENMVS_BIN to a folder with InterfaceCOLMAP and RefineMesh)" >&2
+  exit 0
+fi
+for tool in InterfaceCOLMAP RefineMesh; do
+  [ -x "$OPENMVS_BIN/$tool" ] || { echo "$OPENMVS_BIN/$tool: not found" >&2; exit 1; }
+done
+[ -f "$tools/finecap_capture_to_colmap.py" ] ||
+  { echo "$tools/finecap_capture_to_colmap.py: not found (TOOLS=DIR)" >&2; exit 1; }
+
+# The training capture: the cameras without the held-out ones; images and mesh are symlinks.
+mvs="$work/openmvs"
+mkdir -p "$mvs/train/images" "$mvs/train/meshes" "$mvs/scored/meshes"
+python3 - "$capture" "$mvs/train" <<'PY'
+import os, re, sys
+capture, train = sys.argv[1], sys.argv[2]
+held_out = re.search(r"cameras:\s*\[([^\]]*)\]", open(os.path.join(capture, "heldout.yaml")).read())
+held_out = {name.strip().strip("'\"") for name in held_out.group(1).split(",") if name.strip()}
+# One block per camera: "  - name: ..." and the lines that follow it.
+text = open(os.path.join(capture, "cameras.yaml")).read()
+head, *blocks = re.split(r"(?m)^(?=\s*- name:)", text)
+kept = [b for b in blocks if re.match(r"\s*- name:\s*(\S+)", b).group(1).strip("'\"") not in held_out]
+if len(kept) != len(blocks) - len(held_out):
+    sys.exit(f"{capture}/cameras.yaml: not every held-out camera of heldout.yaml was found")
+open(os.path.join(train, "cameras.yaml"), "w").write(head + "".join(kept))
+for block in kept:
+    name = re.match(r"\s*- name:\s*(\S+)", block).group(1).strip("'\"")
+    os.symlink(os.path.join(capture, "images", name), os.path.join(train, "images", name))
+os.symlink(os.path.join(capture, "meshes", "000000.ply"),
+           os.path.join(train, "meshes", "000000.ply"))
+print(f"openmvs_training_views: {len(kept)}")
+PY
+python3 "$tools/finecap_capture_to_colmap.py" "$mvs/train" "$mvs/colmap" >"$mvs/colmap.log"
+start=$(date +%s.%N)
+(
+  cd "$mvs"
+  /usr/bin/time -f "%e %M" -o interface.time "$OPENMVS_BIN/InterfaceCOLMAP" -i colmap/ \
+    -o scene.mvs --image-folder colmap/images/ >interface.log 2>&1
+  /usr/bin/time -f "%e %M" -o refine.time "$OPENMVS_BIN/RefineMesh" -i scene.mvs \
+    --mesh-file train/meshes/000000.ply -o refined.ply \
+    --resolution-level 0 --min-resolution 640 --max-views 8 --scales 2 --scale-step 0.5 \
+    --decimate 1 --max-face-area 0 --close-holes 0 --ensure-edge-size 0 \
+    --planar-vertex-ratio 0 --max-threads 0 >refine.log 2>&1
+)
+end=$(date +%s.%N)
+[ -f "$mvs/refined.ply" ] || { echo "RefineMesh wrote no $mvs/refined.ply ($mvs/refine.log)" >&2; exit 1; }
+
+# Its mesh as given, scored in the held-out views like the input of a capture with every camera.
+ln -s "$capture/cameras.yaml" "$mvs/scored/cameras.yaml"
+ln -s "$capture/images" "$mvs/scored/images"
+cp "$mvs/refined.ply" "$mvs/scored/meshes/000000.ply"
+as_given=(--config "$capture/heldout.yaml" --capture "$mvs/scored" --out "$mvs/run")
+unchanged=model.subdivision_levels=0,solver.max_iterations=0,refine.sweep.samples=0
+build/finecap refine "${as_given[@]}" --set "$unchanged" >/dev/null 2>"$mvs/score_refine.log"
+build/finecap eval "${as_given[@]}" --set "$unchanged,eval.flow=none" >/dev/null \
+  2>"$mvs/score_eval.log"
+python3 - "$mvs/run/eval/metrics.json" <<'PY'
+import json, sys
+metrics = json.load(open(sys.argv[1]))
+print(f"openmvs_heldout_ncc: {metrics['heldout_ncc_input']:.4f}")
+print(f"openmvs_heldout_mad: {metrics['heldout_mad_input']:.4f}")
+PY
+echo "openmvs_seconds: $(awk -v e="$end" -v s="$start" 'BEGIN { printf "%.1f", e - s }')"
+peak=$(cat "$mvs/interface.time" "$mvs/refine.time" | awk '$2 > m { m = $2 } END { print m }')
+echo "openmvs_peak_mb: $((peak / 1024))"
