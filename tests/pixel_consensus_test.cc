@@ -66,7 +66,7 @@ SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
   scene.surface = MakeSurfaceGaussians(scene.mesh.vertices, normals, ids, colors);
   scene.neighbourhoods = BuildVertexNeighbourhoods(scene.mesh, 2);
   scene.samples = SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods,
-                                /*patch_rings=*/1, levels, nullptr);
+                                /*patch_rings=*/1, levels);
   // The grid's normals point to -z, at the cameras: k moves the surface to z = -k.
   const double z_plane = -truth_offset;
   for (double tilt : {0.0, 0.35, -0.3}) {
@@ -121,13 +121,25 @@ TEST(SurfaceSamplingTest, SamplesKeepTheVerticesAndBlendTheirCorners) {
 TEST(SurfaceSamplingTest, WiderPatchesTakeTheNeighboursFacesToo) {
   SampledScene scene = MakeSampledScene(0.0);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(scene.mesh);
-  const SurfaceSamples wide = SampleSurface(scene.mesh, normals, scene.surface,
-                                            scene.neighbourhoods, /*patch_rings=*/2, 2, nullptr);
+  const SurfaceSamples wide =
+      SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods, /*patch_rings=*/2, 2);
   const int interior = 3 * 7 + 3;
   EXPECT_GT(wide.patches[interior].size(), 3 * scene.samples.patches[interior].size());
   std::vector<int> sorted = wide.patches[interior];
   std::sort(sorted.begin(), sorted.end());
   EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "a sample twice";
+}
+
+TEST(SurfaceSamplingTest, ASampleIsSeenWhereEveryCornerItIsBlendedFromIs) {
+  const SampledScene scene = MakeSampledScene(0.0);
+  std::vector<unsigned char> surface_visible(scene.surface.size(), 1);
+  const int hidden = 3 * 7 + 3;
+  surface_visible[hidden] = 0;
+  const std::vector<unsigned char> visible = SampleVisibility(scene.samples, surface_visible);
+  ASSERT_EQ(visible.size(), static_cast<size_t>(scene.samples.size()));
+  for (int j = 0; j < scene.samples.size(); ++j) {
+    EXPECT_EQ(visible[j] == 0, scene.samples.weights.coeff(j, hidden) > 0.0) << "sample " << j;
+  }
 }
 
 // dE/dk against central differences. The bilinear interpolant has kinks at pixel borders, so a

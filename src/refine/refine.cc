@@ -133,25 +133,30 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 namespace {
 
-// The surface samples of a frame (ConsensusOptions::sample_spacing) and, in each of `cameras`,
-// its pixels and which samples it sees.
-SurfaceSamples SampleFrameSurface(const SequenceModel& model, const PreparedFrame& frame,
-                                  const SurfaceGaussians& surface, const FrameInput& input,
-                                  const RefineOptions& options, std::vector<CameraInput>* cameras) {
+// Replaces the energy of a solved frame by the one that reads its images at their own
+// resolution (ConsensusOptions::sample_spacing) over the same surface Gaussians, with the
+// visibility the frame was prepared with.
+void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
+                         const RefineOptions& options, PreparedFrame* frame) {
+  const auto start = std::chrono::steady_clock::now();
   const ConsensusOptions& consensus = options.energy.consensus;
-  const int levels = SampleLevels(frame.fine, input.cameras, consensus.sample_spacing);
-  Mesh sample_mesh;
-  SurfaceSamples samples = SampleSurface(frame.fine, frame.normals, surface, model.neighbourhoods(),
-                                         consensus.patch_rings, levels, &sample_mesh);
-  const auto visible =
-      ComputeFrameVisibility(sample_mesh, samples.normals, input.cameras, options.visibility);
+  SurfaceGaussians surface = frame->energy->surface();
+  frame->energy.reset();  // Its pair lists and tables are not needed any more.
+  const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
+  SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
+                                         model.neighbourhoods(), consensus.patch_rings, levels);
   const std::vector<cv::Mat> pixels =
       SampledImages(input, options.image.color_space, consensus.sample_blur);
-  for (size_t c = 0; c < cameras->size(); ++c) {
-    (*cameras)[c].pixels = pixels[c];
-    (*cameras)[c].samples_visible = visible[c];
+  std::vector<CameraInput> cameras(input.cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    cameras[c].camera = input.cameras[c];
+    for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
+    cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
+    cameras[c].pixels = pixels[c];
   }
-  return samples;
+  frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
+                                                options.energy, std::move(samples));
+  frame->seconds += SecondsSince(start);
 }
 
 // PrepareFrame without checking `options`, over the image models `images` of the input's images
@@ -159,13 +164,14 @@ SurfaceSamples SampleFrameSurface(const SequenceModel& model, const PreparedFram
 // ranges that a configured value must lie in.
 PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options,
-                           std::vector<ImageGaussians> images, bool with_samples = false) {
+                           std::vector<ImageGaussians> images) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
   frame.normals = ComputeVertexNormals(frame.fine);
-  const auto visible =
+  frame.visible =
       ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
+  const auto& visible = frame.visible;
   frame.images = std::move(images);
 
   // The consensus similarity compares the cameras of this frame with each other; the colours
@@ -186,12 +192,8 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
     frame.num_image_gaussians += frame.images[c].size();
   }
-  SurfaceSamples samples;
-  if (with_samples) {
-    samples = SampleFrameSurface(model, frame, surface, input, options, &cameras);
-  }
   frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                               options.energy, std::move(samples));
+                                               options.energy);
   if (!frame.energy->similarity().ReadsPairLists())
     std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
@@ -242,11 +244,12 @@ void ShapePatchesLike(const Eigen::VectorXd& k, const RefineOptions& options, Fr
 
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
+  const int passes = options.energy.consensus.passes;
   const Eigen::VectorXd start = *k;
   FrameSolver solver(energy, options.solver, workspace);  // One Ceres problem for all the passes.
   SolverSummary summary = solver.Solve(k);
   if (!energy->similarity().ShapesPatches()) return summary;
-  for (int pass = 1; pass < options.energy.consensus.passes; ++pass) {
+  for (int pass = 1; pass < passes; ++pass) {
     ShapePatchesLike(*k, options, energy);
     const SolverSummary more = solver.Solve(k);
     summary.energy_end = more.energy_end;
@@ -255,7 +258,7 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     summary.termination = more.termination;
     summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
   }
-  if (options.energy.consensus.passes > 1) {
+  if (passes > 1) {
     // Both ends by the same sum: the solver's own (Ceres') may differ from it in the last digit.
     EvaluateEnergyAndCost(energy, start, &summary.energy_start, &summary.ls_cost_start);
     EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
@@ -337,13 +340,10 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     result.summary.AddWork(coarse);
   }
   if (UsesSurfaceSamples(options)) {
-    // The images at their own resolution, from the surface the surface Gaussians found: the
-    // detail stage replaces the frame's energy, whose pair lists it no longer needs.
-    frame.energy.reset();
-    PreparedFrame detail =
-        PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image), true);
-    result.seconds_preparation += detail.seconds;
-    frame.energy = std::move(detail.energy);
+    // The images at their own resolution, from the surface the surface Gaussians found.
+    const double seconds = frame.seconds;
+    PrepareDetailEnergy(model, input, options, &frame);
+    result.seconds_preparation += frame.seconds - seconds;
     ShapePatchesLike(k, options, frame.energy.get());
     SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
     EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,

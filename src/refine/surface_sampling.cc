@@ -23,7 +23,7 @@ int SampleLevels(const Mesh& mesh, const std::vector<Camera>& cameras, double sp
 SurfaceSamples SampleSurface(const Mesh& mesh, const Eigen::Matrix3Xd& normals,
                              const SurfaceGaussians& surface,
                              const VertexNeighbourhoods& neighbourhoods, int patch_rings,
-                             int levels, Mesh* sample_mesh) {
+                             int levels) {
   const SubdivisionStencil stencil = BuildLinearSubdivision(mesh, levels);
   SurfaceSamples samples;
   samples.base = mesh.vertices * stencil.matrix.transpose();
@@ -65,11 +65,19 @@ SurfaceSamples SampleSurface(const Mesh& mesh, const Eigen::Matrix3Xd& normals,
         add_samples_of(neighbourhoods.neighbours[e], s);
     }
   }
-  if (sample_mesh != nullptr) {
-    sample_mesh->vertices = samples.base;
-    sample_mesh->faces = stencil.faces;
-  }
   return samples;
+}
+
+std::vector<unsigned char> SampleVisibility(const SurfaceSamples& samples,
+                                            const std::vector<unsigned char>& surface_visible) {
+  std::vector<unsigned char> visible(samples.size(), 0);
+  for (int j = 0; j < samples.size(); ++j) {
+    Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(samples.weights, j);
+    if (!it) continue;  // Blended from no surface Gaussian: in no patch.
+    visible[j] = 1;
+    for (; it; ++it) visible[j] &= surface_visible[it.col()];
+  }
+  return visible;
 }
 
 std::vector<cv::Mat> SampledImages(const FrameInput& input, ColorSpace space, double blur) {

@@ -25,12 +25,18 @@ int SampleLevels(const Mesh& mesh, const std::vector<Camera>& cameras, double sp
 // `mesh`; a sample of a face none of whose corners is a surface Gaussian keeps no weight). The
 // patch of a surface Gaussian holds the samples of the faces around it and, for `patch_rings`
 // above 1, around its neighbours up to patch_rings - 1 edges away (`neighbourhoods`, over the
-// vertices of `mesh`, must reach that far). `sample_mesh`, when not null, receives the
-// subdivided mesh.
+// vertices of `mesh`, must reach that far).
 SurfaceSamples SampleSurface(const Mesh& mesh, const Eigen::Matrix3Xd& normals,
                              const SurfaceGaussians& surface,
                              const VertexNeighbourhoods& neighbourhoods, int patch_rings,
-                             int levels, Mesh* sample_mesh);
+                             int levels);
+
+// Which samples a camera sees, from which surface Gaussians it sees (one flag each): a sample is
+// seen when every surface Gaussian it is blended from is. (A face whose corners a camera sees is
+// seen whole but where a smaller occluder covers its inside, which the visibility of vertices
+// misses as well.)
+std::vector<unsigned char> SampleVisibility(const SurfaceSamples& samples,
+                                            const std::vector<unsigned char>& surface_visible);
 
 // Each camera's image in `space`, blurred by a Gaussian of `blur` pixels (none when 0), as the
 // samples read it (CameraInput::pixels).

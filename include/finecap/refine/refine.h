@@ -203,6 +203,8 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 struct PreparedFrame {
   Mesh fine;                 // The subdivided input mesh.
   Eigen::Matrix3Xd normals;  // Its unit normals, along which k displaces.
+  // Per camera, which vertices of `fine` it sees (ComputeVisibility).
+  std::vector<std::vector<unsigned char>> visible;
   // One per camera, while the energy refers to them: none once it is built when its similarity
   // reads no pair list after (SimilarityTerm::ReadsPairLists; the consensus similarity's tables
   // hold what it needs), which spares a frame's image models (~7 MB on synth_skirt) while it is
