@@ -25,13 +25,14 @@ std::string* RefineFrameTest::directory_ = nullptr;
 
 // With a schedule, the figures of the frame still refer to the configured energy: it starts
 // where a single-level solve starts and ends at the energy of the k it returns. One consensus
-// pass: a further pass shapes the patches like the surface found, so its energy depends on the
-// solve that came before it.
+// pass and no detail stage: a further pass, and the detail stage, shape the patches like the
+// surface found, so their energy depends on the solve that came before them.
 TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
   Capture capture = Capture::Open(*directory_);
   RefineOptions options;
   options.visibility.max_view_angle_deg = 60.0;
   options.energy.consensus.passes = 1;
+  options.energy.consensus.sample_spacing = 0.0;
   const FrameInput input = ReadFrameInput(&capture, 1);
   const SequenceModel model(input.coarse, {}, options, "test");
   const ReferenceColors colors = ComputeSequenceColors(model, ReadFrameInput(&capture, 0), options);

@@ -336,6 +336,10 @@ TEST(SubdivisionTest, RefusesNonManifoldEdgesAndWrongFrames) {
     EXPECT_NE(message.find("non-manifold"), std::string::npos) << message;
   }
   EXPECT_THROW(BuildLoopSubdivision(Icosahedron(), -1), Error);
+  // Midpoints need no rule across the edge: the linear scheme splits the fan.
+  const SubdivisionStencil split = BuildLinearSubdivision(fan, 1, "fan.ply");
+  EXPECT_EQ(split.faces.cols(), 12);
+  EXPECT_EQ(split.num_fine_vertices(), 5 + 7);
 
   const SubdivisionStencil stencil = BuildLoopSubdivision(Icosahedron(), 1);
   try {

@@ -153,8 +153,9 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
                  "Subdivision levels applied to the coarse mesh before refinement.", 0, 4);
   schema->AddEnum("model.subdivision", &refine.subdivision,
                   "Scheme of that subdivision: loop (approximating: moves the input's vertices "
-                  "onto a smoother surface) or butterfly (modified butterfly, interpolating: "
-                  "keeps them and places only the new vertices).");
+                  "onto a smoother surface), butterfly (modified butterfly, interpolating: "
+                  "keeps them and places only the new vertices) or linear (the input's faces "
+                  "split, its surface unchanged).");
   schema->AddDoubleOrAuto(
       "model.sigma_hat", &refine.sigma_hat, &refine.scene_lengths.sigma_hat,
       "Standard deviation of every surface Gaussian, metres (paper: 0.007); " + SigmaHatAutoText(),

@@ -319,7 +319,8 @@ void AddMidpoints(int num_vertices, const MeshEdges& edges, Triplets* triplets) 
 OneLevel SubdivideOnce(SubdivisionScheme scheme, int num_vertices, const Eigen::Matrix3Xi& faces,
                        const std::string& where) {
   const MeshEdges edges = BuildMeshEdges(faces);
-  RequireManifoldEdges(scheme, edges, where);
+  // Midpoints are defined on any edge; the smooth schemes' rules need at most two sides.
+  if (scheme != SubdivisionScheme::kLinear) RequireManifoldEdges(scheme, edges, where);
   Triplets triplets;
   if (scheme == SubdivisionScheme::kButterfly) {
     triplets.reserve(num_vertices + 10 * static_cast<size_t>(edges.num_edges()));

@@ -3,11 +3,13 @@
 #include "energy/consensus_similarity.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <glog/logging.h>
 
 #include "finecap/energy/frame_energy.h"
 #include "finecap/model/gaussian_pairs.h"
+#include "refine/surface_sampling.h"
 
 namespace finecap {
 namespace {
@@ -56,6 +58,22 @@ constexpr int kFramesHeldBySeveral = 3;
 constexpr double kSecondsPerPair = 0.16e-6;
 constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 
+// The detail stage (ConsensusOptions::sample_spacing): each camera's image as 3 floats a pixel,
+// and per surface sample its position, direction, blend weights and visibility; its time, per
+// sample read in a patch in one camera, over the ~25 evaluations of its two passes
+// (synth_skirt: 0.6 s a frame for 1.7 M reads an evaluation, 2 cores). Not refitted: from one
+// capture.
+constexpr double kBytesPerSampledPixel = 12.0;
+constexpr double kBytesPerSurfaceSample = 110.0;
+constexpr double kSecondsPerSampleRead = 0.35e-6;
+
+// The samples of a regular vertex's patch after `levels` of linear subdivision: the hexagon of
+// radius 2^levels without its rim.
+int SamplesPerRegularPatch(int levels) {
+  const int radius = 1 << levels;
+  return 1 + 3 * (radius - 1) * radius;
+}
+
 }  // namespace
 
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
@@ -102,12 +120,21 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
     per_frame += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation);
   }
+  double detail_bytes = 0.0, detail_seconds = 0.0;
+  if (consensus && options.energy.consensus.sample_spacing > 0.0) {
+    const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
+    size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
+    size.samples_per_patch = SamplesPerRegularPatch(levels);
+    detail_bytes =
+        size.num_pixels * kBytesPerSampledPixel + size.num_surface_samples * kBytesPerSurfaceSample;
+    detail_seconds = size.num_observations * double(size.samples_per_patch) * kSecondsPerSampleRead;
+  }
   const bool cholesky = options.solver.type == SolverType::kCeres &&
                         options.solver.linear_solver != LinearSolverType::kCgnr;
   const int frames_held = num_frames > 1 ? kFramesHeldBySeveral : 1;
   const double bytes =
       size.num_pixels * kBytesPerPixel + undistorted_pixels * kBytesPerUndistortedPixel +
-      frames_held * per_frame +
+      frames_held * per_frame + detail_bytes +
       size.num_surface_gaussians *
           (kBytesPerSurfaceGaussian + (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
@@ -115,8 +142,8 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   VLOG(1) << "memory forecast of " << frames_held << " frame(s) held: " << size.num_pixels
           << " pixels, " << size.num_pairs << " pairs, " << size.num_observations
           << " observations of " << size.num_surface_gaussians << " surface Gaussians";
-  size.seconds_per_frame =
-      size.num_pairs * kSecondsPerPair + size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
+  size.seconds_per_frame = size.num_pairs * kSecondsPerPair +
+                           size.num_surface_gaussians * kSecondsPerSurfaceGaussian + detail_seconds;
   return size;
 }
 

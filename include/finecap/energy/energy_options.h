@@ -48,14 +48,16 @@ struct ConsensusOptions {
   // Cauchy's robust loss on each patch's squared disagreement, with its scale this fraction of
   // the disagreement of unrelated patches; 0 turns it off (plain least squares).
   double robust_fraction = 0.5;
-  // Where the colours of a patch are read. 0: at its surface Gaussians, one per vertex, blurred
-  // by sigma_hat (ConsensusSimilarity). Above 0: at samples of the refined surface about this
-  // many pixel footprints apart, the faces of the mesh split (linearly) until their edges are
-  // that short, read at the images' own resolution (PixelConsensusSimilarity). Default 0.
-  double sample_spacing = 0.0;
+  // Where the colours of a patch are read. 0: at its surface Gaussians only, one per vertex,
+  // blurred by sigma_hat (ConsensusSimilarity). Above 0: then a second solve, from the surface
+  // the surface Gaussians found, reads them at samples of the refined surface about this many
+  // pixel footprints apart (the faces split linearly until their edges are that short), at the
+  // images' own resolution (PixelConsensusSimilarity): detail between the vertices, which the
+  // Gaussians blur away, steers each vertex. Default 1.
+  double sample_spacing = 1.0;
   // With samples: the standard deviation, in pixels, of the Gaussian the images are blurred by
-  // before the samples read them by bilinear interpolation. Default 0.7.
-  double sample_blur = 0.7;
+  // before the samples read them by bilinear interpolation. Default 0.4.
+  double sample_blur = 0.4;
 
   void Check() const;
 };

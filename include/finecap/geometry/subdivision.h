@@ -85,8 +85,9 @@ struct SubdivisionStencil {
 
 // Builds S and the fine faces for `levels` rounds of subdivision by `scheme` (0 gives the identity
 // and the coarse faces). Uses the connectivity of `coarse` only. Throws Error(where, ...) when the
-// mesh fails Mesh::Validate, when levels is negative or would overflow the vertex ids, or when an
-// edge is in three or more triangles (non-manifold: neither scheme's rules are defined there).
+// mesh fails Mesh::Validate, when levels is negative or would overflow the vertex ids, or, but
+// for kLinear, when an edge is in three or more triangles (non-manifold: Loop's and the
+// butterfly's rules are not defined there; a midpoint is).
 SubdivisionStencil BuildSubdivision(SubdivisionScheme scheme, const Mesh& coarse, int levels,
                                     const std::string& where = "mesh");
 

@@ -39,6 +39,10 @@ struct ProblemSize {
   double num_pixels = 0.0;       // Over every camera.
   // Surface Gaussian and camera pairs that see each other: the residual blocks of the solve.
   long num_observations = 0;
+  // With the detail stage (ConsensusOptions::sample_spacing): the surface samples, and the
+  // samples a patch holds (of a regular vertex's).
+  double num_surface_samples = 0.0;
+  int samples_per_patch = 0;
 
   // Forecast peak resident memory of a run refining frames like this one, MB.
   double peak_memory_mb = 0.0;
