@@ -103,13 +103,11 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
                                          const std::vector<std::vector<int>>& one_rings,
                                          OverlapForm form, double k_max, double reach_sigmas,
                                          const ConsensusOptions& options)
-    : surface_(surface),
+    : PatchAgreementTerm(options, static_cast<int>(views.size())),
+      surface_(surface),
       views_(views),
       form_(form),
-      reach_sigmas_(reach_sigmas),
-      options_(options),
-      scale_(1.0 / std::sqrt(static_cast<double>(std::max<size_t>(views.size(), 1)))) {
-  options_.Check();
+      reach_sigmas_(reach_sigmas) {
   Require(one_rings.size() == static_cast<size_t>(surface.size()), "consensus similarity",
           "one neighbour list per surface Gaussian expected");
   first_row_.assign(1, 0);
@@ -132,30 +130,14 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
       for (int j : patch) rows.push_back(first_row_[c] + rows_of[c][j]);
     }
     if (static_cast<int>(cameras.size()) < options_.min_cameras) continue;
-    patch_begin_.push_back(static_cast<int>(members_.size()));
-    members_.insert(members_.end(), patch.begin(), patch.end());
-    camera_begin_.push_back(static_cast<int>(cameras_.size()));
-    cameras_.insert(cameras_.end(), cameras.begin(), cameras.end());
+    AddPatch(s, patch, cameras);
     rows_.insert(rows_.end(), rows.begin(), rows.end());
     row_begin_.push_back(static_cast<long>(rows_.size()));
-    blocks_.push_back({{s}, 3 * static_cast<int>(rows.size())});
-  }
-  patch_begin_.push_back(static_cast<int>(members_.size()));
-  camera_begin_.push_back(static_cast<int>(cameras_.size()));
-  for (size_t b = 0; b < blocks_.size(); ++b) {
-    max_block_rows_ =
-        std::max(max_block_rows_, static_cast<int>(row_begin_[b + 1] - row_begin_[b]));
-  }
-
-  residual_begin_.assign(1, 0);
-  for (const ResidualBlock& block : blocks_) {
-    residual_begin_.push_back(residual_begin_.back() + block.num_residuals);
+    max_block_rows_ = std::max(max_block_rows_, static_cast<int>(rows.size()));
   }
   shape_ = Eigen::VectorXd::Zero(surface.size());
   BuildTables(k_max);
-  weights_.resize(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 64)
-  for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) weights_[b] = PatchContrast(b);
+  WeighPatches();
 }
 
 int ConsensusSimilarity::NumTableNodes(double sigma_hat, double k_max) {
@@ -322,7 +304,7 @@ void ConsensusSimilarity::PatchColors(int b, double k, double* colors, double* d
   // each camera only reads its two nodes.
   thread_local std::vector<HermiteWeights> weights;
   weights.resize(n);
-  const int* members = &members_[patch_begin_[b]];
+  const int* members = Members(b);
   const double centre_shape = shape_[members[0]];
   for (int m = 0; m < n; ++m) weights[m] = HermiteAt(k + shape_[members[m]] - centre_shape);
   for (int a = 0; a < num_cameras; ++a) {
@@ -341,83 +323,6 @@ void ConsensusSimilarity::SetPatchShape(const Eigen::VectorXd& shape) {
   shape_ = shape;
 }
 
-Eigen::Vector3d ConsensusSimilarity::PatchContrast(int b) const {
-  const int n = PatchSize(b), num_cameras = NumCameras(b);
-  std::vector<double> colors(3 * n * num_cameras);
-  PatchColors(b, 0.0, colors.data(), nullptr);
-  return internal::PatchContrast(n, num_cameras, colors.data());
-}
-
-void ConsensusSimilarity::PlainResiduals(int b, double k, double* residuals,
-                                         double* jacobian) const {
-  // The colours become the residuals in place.
-  PatchColors(b, k, residuals, jacobian);
-  internal::AgreementResiduals(PatchSize(b), NumCameras(b), options_.contrast_floor,
-                               !options_.gain_per_channel, scale_ * weights_[b], residuals,
-                               jacobian);
-}
-
-double ConsensusSimilarity::LossScale(int b) const {
-  return internal::AgreementLossScale(PatchSize(b), NumCameras(b), scale_ * weights_[b],
-                                      options_.robust_fraction);
-}
-
-void ConsensusSimilarity::BlockAt(int b, double k, double* residuals, double* jacobian) const {
-  PlainResiduals(b, k, residuals, jacobian);
-  Robustify(LossScale(b), blocks_[b].num_residuals, residuals, jacobian);
-}
-
-SimilarityTerm::BlockSummary ConsensusSimilarity::SummaryAt(int b, double k,
-                                                            bool with_derivatives) const {
-  thread_local std::vector<double> residuals, jacobian;
-  const int num_residuals = blocks_[b].num_residuals;
-  residuals.resize(num_residuals);
-  jacobian.resize(with_derivatives ? num_residuals : 0);
-  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr);
-  BlockSummary plain;
-  if (with_derivatives) {
-    plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
-  } else {
-    for (int r = 0; r < num_residuals; ++r) plain.squared_norm += residuals[r] * residuals[r];
-  }
-  return Robustify(LossScale(b), plain, with_derivatives);
-}
-
-double ConsensusSimilarity::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {
-  if (gradient != nullptr) *gradient = Eigen::VectorXd::Zero(k.size());
-  const int num_blocks = static_cast<int>(blocks_.size());
-  double sum_of_squares = 0.0;
-#pragma omp parallel for schedule(dynamic, 64) reduction(+ : sum_of_squares)
-  for (int b = 0; b < num_blocks; ++b) {
-    const int s = blocks_[b].parameters[0];
-    const BlockSummary summary = SummaryAt(b, k[s], gradient != nullptr);
-    sum_of_squares += summary.squared_norm;
-    // Each block owns one parameter: no two threads write the same entry.
-    if (gradient != nullptr) (*gradient)[s] = -summary.gradient;
-  }
-  return -0.5 * sum_of_squares;
-}
-
-void ConsensusSimilarity::PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) {
-  residuals_.resize(residual_begin_.back());
-  jacobians_.resize(with_jacobians ? residual_begin_.back() : 0);
-  const int num_blocks = static_cast<int>(blocks_.size());
-#pragma omp parallel for schedule(dynamic, 64)
-  for (int b = 0; b < num_blocks; ++b) {
-    BlockAt(b, k[blocks_[b].parameters[0]], &residuals_[residual_begin_[b]],
-            with_jacobians ? &jacobians_[residual_begin_[b]] : nullptr);
-  }
-}
-
-void ConsensusSimilarity::PrepareBlockSummaries(const Eigen::VectorXd& k) {
-  const int num_blocks = static_cast<int>(blocks_.size());
-  summaries_.resize(num_blocks);
-#pragma omp parallel for schedule(dynamic, 64)
-  for (int b = 0; b < num_blocks; ++b) {
-    summaries_[b] = SummaryAt(b, k[blocks_[b].parameters[0]], true);
-  }
-}
-
 void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
   const int num_blocks = static_cast<int>(blocks_.size());
   costs->resize(num_blocks);
@@ -427,10 +332,7 @@ void ConsensusSimilarity::BlockCosts(const Eigen::VectorXd& k, std::vector<doubl
     UniformCosts<1>(k.data(), costs->data(), num_blocks, &lane_colors);
     return;
   }
-#pragma omp parallel for schedule(dynamic, 64)
-  for (int b = 0; b < num_blocks; ++b) {
-    (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
-  }
+  PatchAgreementTerm::BlockCosts(k, costs);
 }
 
 void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
@@ -523,13 +425,6 @@ void ConsensusSimilarity::UniformCostsOfBlock(int b, const double* lane_colors, 
     plain.squared_norm = squared_norm[lane];
     costs[lane] = Robustify(c2, plain, false).squared_norm;
   }
-}
-
-void ConsensusSimilarity::BlockResiduals(int block, double* residuals, double* jacobian) const {
-  const long begin = residual_begin_[block];
-  const int num_residuals = blocks_[block].num_residuals;
-  std::copy_n(&residuals_[begin], num_residuals, residuals);
-  if (jacobian != nullptr) std::copy_n(&jacobians_[begin], num_residuals, jacobian);
 }
 
 }  // namespace finecap

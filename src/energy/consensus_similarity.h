@@ -48,6 +48,7 @@
 
 #include <vector>
 
+#include "energy/patch_agreement.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/similarity.h"
 #include "finecap/model/gaussian_overlap.h"
@@ -55,7 +56,7 @@
 
 namespace finecap {
 
-class ConsensusSimilarity : public SimilarityTerm {
+class ConsensusSimilarity : public PatchAgreementTerm {
  public:
   // Nodes of each colour table for Gaussians of `sigma_hat` over [-k_max, k_max].
   static int NumTableNodes(double sigma_hat, double k_max);
@@ -66,17 +67,10 @@ class ConsensusSimilarity : public SimilarityTerm {
                       const std::vector<std::vector<int>>& one_rings, OverlapForm form,
                       double k_max, double reach_sigmas, const ConsensusOptions& options);
 
-  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
-  const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
-  void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
-  void BlockResiduals(int block, double* residuals, double* jacobian) const override;
-  // Each block's summary straight from its residuals before the robust loss, without storing
-  // them (a frame's ~0.8 M residuals and as many derivatives, written and read back at every
-  // evaluation otherwise), the loss applied to the sums.
-  void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
-  bool IsLeastSquares() const override { return true; }
-  // The tables hold all it reads of the pairs.
-  bool ReadsPairLists() const override { return false; }
+  // (PatchAgreementTerm: the residuals, summaries and costs. Its block summaries come straight
+  // from the residuals, without storing them: a frame's ~0.8 M residuals and as many derivatives,
+  // written and read back at every evaluation otherwise. The tables hold all it reads of the
+  // pairs.)
   // Each block's sum of squares without storing its residuals. Where every k_s is the same and
   // the patches are flat, as UniformBlockCosts.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
@@ -90,7 +84,6 @@ class ConsensusSimilarity : public SimilarityTerm {
   // The shape of the patches: member j of patch s is read at k_s + shape[j] - shape[s] instead of
   // k_s, so that a patch moves as a piece of the surface `shape` instead of the input surface.
   // One entry per surface Gaussian; zero (the input surface) until set.
-  bool ShapesPatches() const override { return true; }
   void SetPatchShape(const Eigen::VectorXd& shape) override;
 
   // Camera c's tabulated colour of pair-list row `row` at k, and dcolour/dk (when not null). At
@@ -98,9 +91,6 @@ class ConsensusSimilarity : public SimilarityTerm {
   // Gaussians within reach there, in single precision; between them a cubic Hermite
   // interpolation.
   Eigen::Vector3d Interpolate(int c, int row, double k, Eigen::Vector3d* derivative) const;
-
-  // The weight w_s of each block, per channel (the patch's contrast at the input surface).
-  const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
 
   // The image Gaussians of one pair-list row as the tables' loop reads them: one array per
   // quantity, in single precision, so that the loop runs over several of them at a time.
@@ -146,26 +136,9 @@ class ConsensusSimilarity : public SimilarityTerm {
   // once per node.
   void TabulateRow(const EnergyView& view, int row, RowImageGaussians* paired,
                    TableNode* nodes) const;
-  // Number of members of block b's patch (centre first).
-  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
-  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
   // The colours of block b's patch in each of its cameras with every member displaced by k along
-  // its own normal (and the patch's shape), interpolated in the tables, and, when `derivatives`
-  // is not null, their k-derivatives. Written camera after camera, member after member, channel
-  // after channel: the order of the block's residuals.
-  void PatchColors(int b, double k, double* colors, double* derivatives) const;
-  // The per-channel root mean variance of block b's patch over its cameras at the input surface.
-  Eigen::Vector3d PatchContrast(int b) const;
-  // The residuals of block b at displacement k of its patch before the robust loss, and, when
-  // `jacobian` is not null, their derivatives.
-  void PlainResiduals(int b, double k, double* residuals, double* jacobian) const;
-  // The scale c2 of block b's robust loss (none when not positive).
-  double LossScale(int b) const;
-  // Block b's residuals, and their derivatives when `jacobian` is not null.
-  void BlockAt(int b, double k, double* residuals, double* jacobian) const;
-  // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
-  // applied to the sums instead of to every residual: what the solvers and the sweep need.
-  BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
+  // its own normal (and the patch's shape), interpolated in the tables.
+  void PatchColors(int b, double k, double* colors, double* derivatives) const override;
   // Every block's cost, as SummaryAt's squared_norm, with all k_s at each of
   // displacements[0 .. kLanes) and flat patches: costs[b + lane * column_stride]. Every table
   // row's colour at each displacement goes to `lane_colors` (row, channel, lane).
@@ -183,19 +156,11 @@ class ConsensusSimilarity : public SimilarityTerm {
   const std::vector<EnergyView>& views_;
   OverlapForm form_;
   double reach_sigmas_;
-  ConsensusOptions options_;
-  double scale_;  // 1 / sqrt(n_c).
-
-  std::vector<ResidualBlock> blocks_;  // One per patch; its parameter: the centre's k.
-  // Block b's patch members (surface Gaussians, centre first) are
-  // members_[patch_begin_[b] ..), and its cameras cameras_[camera_begin_[b] ..). For each of
-  // those cameras in turn, rows_ (from row_begin_[b]) holds every member's table row: its row in
-  // that camera's pair list plus the camera's first_row_.
-  std::vector<int> patch_begin_, members_;
-  std::vector<int> camera_begin_, cameras_;
+  // A block's patch members are surface Gaussians, the centre first; its parameter, the centre's
+  // k. For each of its cameras in turn, rows_ (from row_begin_[b]) holds every member's table
+  // row: its row in that camera's pair list plus the camera's first_row_.
   std::vector<long> row_begin_;
   std::vector<int> rows_;
-  std::vector<Eigen::Vector3d> weights_;
 
   // Node g of the tables is at k = node_k0_ + g * node_step_. All cameras' rows in one table:
   // camera c's pair-list row `row` is table row first_row_[c] + row, its node g at
@@ -206,10 +171,6 @@ class ConsensusSimilarity : public SimilarityTerm {
   std::vector<TableNode> table_;
   Eigen::VectorXd shape_;
   int max_block_rows_ = 0;  // The most table rows a block reads.
-
-  // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
-  std::vector<long> residual_begin_;
-  std::vector<double> residuals_, jacobians_;
 };
 
 }  // namespace finecap

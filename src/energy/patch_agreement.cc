@@ -159,4 +159,113 @@ SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSum
 }
 
 }  // namespace internal
+
+PatchAgreementTerm::PatchAgreementTerm(const ConsensusOptions& options, int num_cameras)
+    : options_(options), scale_(1.0 / std::sqrt(static_cast<double>(std::max(num_cameras, 1)))) {
+  options_.Check();
+}
+
+void PatchAgreementTerm::AddPatch(int parameter, const std::vector<int>& members,
+                                  const std::vector<int>& cameras) {
+  members_.insert(members_.end(), members.begin(), members.end());
+  patch_begin_.push_back(static_cast<int>(members_.size()));
+  cameras_.insert(cameras_.end(), cameras.begin(), cameras.end());
+  camera_begin_.push_back(static_cast<int>(cameras_.size()));
+  blocks_.push_back({{parameter}, 3 * static_cast<int>(members.size() * cameras.size())});
+  residual_begin_.push_back(residual_begin_.back() + blocks_.back().num_residuals);
+}
+
+void PatchAgreementTerm::WeighPatches() {
+  weights_.resize(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) {
+    std::vector<double> colors(3 * PatchSize(b) * NumCameras(b));
+    PatchColors(b, 0.0, colors.data(), nullptr);
+    weights_[b] = internal::PatchContrast(PatchSize(b), NumCameras(b), colors.data());
+  }
+}
+
+void PatchAgreementTerm::PlainResiduals(int b, double k, double* residuals,
+                                        double* jacobian) const {
+  // The colours become the residuals in place.
+  PatchColors(b, k, residuals, jacobian);
+  internal::AgreementResiduals(PatchSize(b), NumCameras(b), options_.contrast_floor,
+                               !options_.gain_per_channel, scale_ * weights_[b], residuals,
+                               jacobian);
+}
+
+double PatchAgreementTerm::LossScale(int b) const {
+  return internal::AgreementLossScale(PatchSize(b), NumCameras(b), scale_ * weights_[b],
+                                      options_.robust_fraction);
+}
+
+SimilarityTerm::BlockSummary PatchAgreementTerm::SummaryAt(int b, double k,
+                                                           bool with_derivatives) const {
+  thread_local std::vector<double> residuals, jacobian;
+  const int num_residuals = blocks_[b].num_residuals;
+  residuals.resize(num_residuals);
+  jacobian.resize(with_derivatives ? num_residuals : 0);
+  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr);
+  BlockSummary plain;
+  if (with_derivatives) {
+    plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
+  } else {
+    for (int r = 0; r < num_residuals; ++r) plain.squared_norm += residuals[r] * residuals[r];
+  }
+  return internal::Robustify(LossScale(b), plain, with_derivatives);
+}
+
+double PatchAgreementTerm::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const {
+  if (gradient != nullptr) *gradient = Eigen::VectorXd::Zero(k.size());
+  const int num_blocks = static_cast<int>(blocks_.size());
+  double sum_of_squares = 0.0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : sum_of_squares)
+  for (int b = 0; b < num_blocks; ++b) {
+    const int s = blocks_[b].parameters[0];
+    const BlockSummary summary = SummaryAt(b, k[s], gradient != nullptr);
+    sum_of_squares += summary.squared_norm;
+    // Each block owns one parameter: no two threads write the same entry.
+    if (gradient != nullptr) (*gradient)[s] = -summary.gradient;
+  }
+  return -0.5 * sum_of_squares;
+}
+
+void PatchAgreementTerm::PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) {
+  residuals_.resize(residual_begin_.back());
+  jacobians_.resize(with_jacobians ? residual_begin_.back() : 0);
+  const int num_blocks = static_cast<int>(blocks_.size());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    double* residuals = &residuals_[residual_begin_[b]];
+    double* jacobian = with_jacobians ? &jacobians_[residual_begin_[b]] : nullptr;
+    PlainResiduals(b, k[blocks_[b].parameters[0]], residuals, jacobian);
+    internal::Robustify(LossScale(b), blocks_[b].num_residuals, residuals, jacobian);
+  }
+}
+
+void PatchAgreementTerm::BlockResiduals(int block, double* residuals, double* jacobian) const {
+  const long begin = residual_begin_[block];
+  const int num_residuals = blocks_[block].num_residuals;
+  std::copy_n(&residuals_[begin], num_residuals, residuals);
+  if (jacobian != nullptr) std::copy_n(&jacobians_[begin], num_residuals, jacobian);
+}
+
+void PatchAgreementTerm::PrepareBlockSummaries(const Eigen::VectorXd& k) {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  summaries_.resize(num_blocks);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    summaries_[b] = SummaryAt(b, k[blocks_[b].parameters[0]], true);
+  }
+}
+
+void PatchAgreementTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  costs->resize(num_blocks);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    (*costs)[b] = SummaryAt(b, k[blocks_[b].parameters[0]], false).squared_norm;
+  }
+}
+
 }  // namespace finecap

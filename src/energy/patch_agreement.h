@@ -4,8 +4,11 @@
 #ifndef FINECAP_SRC_ENERGY_PATCH_AGREEMENT_H_
 #define FINECAP_SRC_ENERGY_PATCH_AGREEMENT_H_
 
+#include <vector>
+
 #include <Eigen/Core>
 
+#include "finecap/energy/energy_options.h"
 #include "finecap/energy/similarity.h"
 
 namespace finecap {
@@ -45,6 +48,72 @@ SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSum
                                        bool with_derivatives);
 
 }  // namespace internal
+
+// A similarity of patches that must agree across the cameras that see them, one block per patch
+// and one parameter per block (the k of the surface Gaussian the patch moves with): the
+// residuals, robust loss, block summaries and costs of both consensus similarities. A derived
+// term says where a patch's colours come from (PatchColors), adds its patches (AddPatch) and then
+// weighs them (WeighPatches).
+class PatchAgreementTerm : public SimilarityTerm {
+ public:
+  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
+  const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
+  void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
+  void BlockResiduals(int block, double* residuals, double* jacobian) const override;
+  // Each block's summary straight from its residuals before the robust loss, without storing
+  // them, the loss applied to the sums.
+  void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
+  // Each block's sum of squares without storing its residuals.
+  void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
+  bool IsLeastSquares() const override { return true; }
+  bool ReadsPairLists() const override { return false; }
+  bool ShapesPatches() const override { return true; }
+
+  // The weight w_s of each block, per channel (the patch's contrast at the input surface).
+  const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
+
+ protected:
+  // `num_cameras`: the frame's, whose square root divides every residual.
+  PatchAgreementTerm(const ConsensusOptions& options, int num_cameras);
+
+  // The colours of block b's patch in each of its cameras with the patch displaced by k (and
+  // shaped), and, when `derivatives` is not null, their k-derivatives. Written camera after
+  // camera, member after member, channel after channel: the order of the block's residuals.
+  virtual void PatchColors(int b, double k, double* colors, double* derivatives) const = 0;
+
+  // Adds the block of a patch moving with `parameter`: its members (its own first) and cameras.
+  void AddPatch(int parameter, const std::vector<int>& members, const std::vector<int>& cameras);
+  // Sets every block's weight from its colours at the input surface: call once every patch is
+  // added and PatchColors can read them.
+  void WeighPatches();
+
+  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
+  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
+  const int* Members(int b) const { return &members_[patch_begin_[b]]; }
+  const int* Cameras(int b) const { return &cameras_[camera_begin_[b]]; }
+  // The scale c2 of block b's robust loss (none when not positive).
+  double LossScale(int b) const;
+  // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
+  // applied to the sums instead of to every residual: what the solvers and the sweep need.
+  BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
+
+  ConsensusOptions options_;
+  double scale_;  // 1 / sqrt(n_c).
+  std::vector<ResidualBlock> blocks_;
+  std::vector<Eigen::Vector3d> weights_;
+
+ private:
+  // The residuals of block b at displacement k of its patch before the robust loss, and, when
+  // `jacobian` is not null, their derivatives.
+  void PlainResiduals(int b, double k, double* residuals, double* jacobian) const;
+
+  // Block b's members are members_[patch_begin_[b] ..), its cameras cameras_[camera_begin_[b] ..).
+  std::vector<int> patch_begin_ = {0}, members_, camera_begin_ = {0}, cameras_;
+  // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
+  std::vector<long> residual_begin_ = {0};
+  std::vector<double> residuals_, jacobians_;
+};
+
 }  // namespace finecap
 
 #endif  // FINECAP_SRC_ENERGY_PATCH_AGREEMENT_H_

@@ -30,13 +30,13 @@
 #include <Eigen/SparseCore>
 #include <opencv2/core.hpp>
 
+#include "energy/patch_agreement.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/frame_energy.h"
-#include "finecap/energy/similarity.h"
 
 namespace finecap {
 
-class PixelConsensusSimilarity : public SimilarityTerm {
+class PixelConsensusSimilarity : public PatchAgreementTerm {
  public:
   // `samples` and `cameras` must outlive this object; `cameras[c].samples_visible` has one flag
   // per sample and `cameras[c].pixels` is the camera's image in the similarity's colour space
@@ -44,19 +44,8 @@ class PixelConsensusSimilarity : public SimilarityTerm {
   PixelConsensusSimilarity(const SurfaceSamples& samples, const std::vector<CameraInput>& cameras,
                            const ConsensusOptions& options);
 
-  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
-  const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
-  void PrepareResiduals(const Eigen::VectorXd& k, bool with_jacobians) override;
-  void BlockResiduals(int block, double* residuals, double* jacobian) const override;
-  // Each block's summary straight from its residuals, without storing them.
-  void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
-  // Each block's sum of squares without storing its residuals.
-  void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
-  bool IsLeastSquares() const override { return true; }
-  bool ReadsPairLists() const override { return false; }
   // The patches' shape, one entry per surface Gaussian, carried to the samples by
   // SurfaceSamples::weights: sample j of patch s is read at k_s + shape_j - shape_s.
-  bool ShapesPatches() const override { return true; }
   void SetPatchShape(const Eigen::VectorXd& shape) override;
 
   // Camera c's colour of sample j displaced by k along its normal, and dcolour/dk when
@@ -64,31 +53,12 @@ class PixelConsensusSimilarity : public SimilarityTerm {
   Eigen::Vector3d SampleColor(int c, int j, double k, Eigen::Vector3d* derivative) const;
 
  private:
-  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
-  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
-  // The colours of block b's patch in each of its cameras (camera after camera, sample after
-  // sample, channel after channel) with the patch displaced by k, and their k-derivatives when
-  // `derivatives` is not null.
-  void PatchColors(int b, double k, double* colors, double* derivatives) const;
-  void PlainResiduals(int b, double k, double* residuals, double* jacobian) const;
-  double LossScale(int b) const;
-  BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
+  void PatchColors(int b, double k, double* colors, double* derivatives) const override;
 
   const SurfaceSamples& samples_;
-  const std::vector<CameraInput>& cameras_in_;
-  ConsensusOptions options_;
-  double scale_;  // 1 / sqrt(n_c).
-
-  std::vector<ResidualBlock> blocks_;
-  // Block b's samples (its own first) are members_[patch_begin_[b] ..), its cameras
-  // cameras_[camera_begin_[b] ..).
-  std::vector<int> patch_begin_, members_, camera_begin_, cameras_;
-  std::vector<Eigen::Vector3d> weights_;
+  const std::vector<CameraInput>& cameras_;
   Eigen::VectorXd shape_;            // Per sample.
   Eigen::VectorXd parameter_shape_;  // Per surface Gaussian.
-
-  std::vector<long> residual_begin_;
-  std::vector<double> residuals_, jacobians_;
 };
 
 }  // namespace finecap
