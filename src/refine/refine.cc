@@ -228,9 +228,6 @@ bool ReadsImagesAfterPreparation(const RefineOptions& options) {
 
 namespace {
 
-// Solve, and for the consensus similarity the further passes with patches shaped like the surface
-// found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
-// so that `worse` compares the frame by the energy it ended with.
 // Shapes the patches of `energy` like the surface `k` (when its similarity compares patches): the
 // window's displacement, not each member's noise about it (ConsensusOptions).
 void ShapePatchesLike(const Eigen::VectorXd& k, const RefineOptions& options, FrameEnergy* energy) {
@@ -242,6 +239,9 @@ void ShapePatchesLike(const Eigen::VectorXd& k, const RefineOptions& options, Fr
   similarity.SetPatchShape(shape.col(0));
 }
 
+// Solve, and for a similarity of patches the further passes with patches shaped like the surface
+// found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
+// so that `worse` compares the frame by the energy it ended with.
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
   const int passes = options.energy.consensus.passes;
