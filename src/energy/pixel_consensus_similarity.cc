@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <opencv2/core.hpp>
+
 #include "finecap/util/error.h"
 #include "model/surface_projection.h"
 

@@ -27,8 +27,6 @@
 #include <vector>
 
 #include <Eigen/Core>
-#include <Eigen/SparseCore>
-#include <opencv2/core.hpp>
 
 #include "energy/patch_agreement.h"
 #include "finecap/energy/energy_options.h"
