@@ -129,6 +129,25 @@ void BM_BlockSummariesAtSweep(benchmark::State& state) {
 }
 BENCHMARK(BM_BlockSummariesAtSweep)->Unit(benchmark::kMillisecond);
 
+// The detail stage's block summaries (PrepareDetailEnergy: the images read at their own
+// resolution at samples about a pixel apart) where it starts, the surface Gaussians' plane sweep
+// standing in for their solve; on one thread and on all threads.
+void BM_DetailBlockSummaries(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const int threads = state.range(0) > 0 ? static_cast<int>(state.range(0)) : omp_get_num_procs();
+  const RefineOptions options;
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
+  PrepareDetailEnergy(*skirt.model, skirt.input, options, &frame);
+  omp_set_num_threads(threads);
+  for (auto _ : state) frame.energy->similarity().PrepareBlockSummaries(k);
+  omp_set_num_threads(omp_get_num_procs());
+  state.counters["threads"] = threads;
+  state.counters["blocks"] =
+      static_cast<double>(frame.energy->similarity().residual_blocks().size());
+}
+BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
 // One solve of a prepared frame with Ceres and the linear solver named, from the plane sweep's
 // start, as the first of a frame's passes: the solver's own work around the evaluations, beside
 // BM_EnergyAndGradient's evaluation alone. Real time: the solve runs on all threads.

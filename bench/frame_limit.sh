@@ -2,8 +2,10 @@
 # How close a synth_skirt frame (8 cameras of 1004 x 1004, ~10k surface Gaussians) comes to its
 # lower bound on this machine. The bound: the evaluations the solve needs, each one pass over the
 # pairs with Jacobians (build/energy_benchmark, all threads), plus reading the frame's images
-# (decoding and undistortion, one thread). Beside it the measured per-stage times of
-# `finecap refine` (medians over the frames of stats.jsonl).
+# (decoding and undistortion, one thread). The bound prices every evaluation at the surface
+# Gaussians' cost; one_detail_pass_ms is what an evaluation of the detail stage (the images read at
+# their own resolution; about half of a frame's evaluations) costs instead. Beside it the measured
+# per-stage times of `finecap refine` (medians over the frames of stats.jsonl).
 #
 #   bash bench/frame_limit.sh            # 10 frames; FRAMES=5 for a quicker look
 #   SOLVER=gradient-ascent bash bench/frame_limit.sh
@@ -51,9 +53,10 @@ peak_of() { values_of peak_rss_mb "$@" | sort -g | tail -1; }
 
 # Medians of 5 repetitions, milliseconds.
 bench=$(build/energy_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
-  --benchmark_filter='BM_EnergyAndGradient/consensus/0|BM_ReadFrame|BM_PrepareFrame' 2>/dev/null)
+  --benchmark_filter='BM_EnergyAndGradient/consensus/0|BM_DetailBlockSummaries/0|BM_ReadFrame|BM_PrepareFrame' 2>/dev/null)
 ms_of() { echo "$bench" | awk -v n="$1" '$1 ~ n && $1 ~ /_median$/ { print $2; exit }'; }
 evaluation_ms=$(ms_of 'BM_EnergyAndGradient/consensus/0')
+detail_evaluation_ms=$(ms_of 'BM_DetailBlockSummaries/0')
 read_ms=$(ms_of 'BM_ReadFrame')
 prepare_ms=$(ms_of 'BM_PrepareFrame')
 
@@ -63,6 +66,7 @@ echo "solver: $solver"
 echo "frames: $frames"
 echo "evaluations_per_frame: $evaluations"
 echo "one_pass_with_jacobians_ms: $evaluation_ms"
+echo "one_detail_pass_ms: $detail_evaluation_ms"
 echo "reading_a_frame_ms: $read_ms"
 echo "preparing_a_frame_ms: $prepare_ms"
 bound=$(awk -v e="$evaluations" -v p="$evaluation_ms" -v r="$read_ms" \

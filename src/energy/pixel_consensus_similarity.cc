@@ -5,8 +5,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "finecap/geometry/spatial_order.h"
 #include "finecap/util/error.h"
-#include "model/surface_projection.h"
 
 namespace finecap {
 namespace {
@@ -14,34 +14,37 @@ namespace {
 // A patch needs its own sample and at least this many more to have a shape worth comparing.
 constexpr int kMinPatchSamples = 4;
 
-// The bilinear interpolant of a CV_32FC3 image at (x, y), pixel centres at integers, and its
-// derivatives along x and y (those of the interpolant, so that they are exact for the function
-// the solvers see). Outside the image the position is clamped to its border, where the
-// derivative across the border is zero.
-struct BilinearRead {
-  Eigen::Vector3d color, dx, dy;
-};
-
-BilinearRead ReadBilinear(const cv::Mat& image, double x, double y) {
+// Writes the bilinear interpolant of a CV_32FC3 image at (x, y), pixel centres at integers, to
+// `color` and, when `derivative` is not null, its derivative along the direction (dx, dy) (that
+// of the interpolant, so that it is exact for the function the solvers see). Outside the image
+// the position is clamped to its border, where the derivative across the border is zero.
+inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, double dy,
+                         double* color, double* derivative) {
   const double max_x = image.cols - 1.0, max_y = image.rows - 1.0;
-  const bool inside_x = x > 0.0 && x<max_x, inside_y = y> 0.0 && y < max_y;
-  x = std::clamp(x, 0.0, max_x);
-  y = std::clamp(y, 0.0, max_y);
+  if (!(x > 0.0 && x < max_x)) {
+    x = std::clamp(x, 0.0, max_x);
+    dx = 0.0;
+  }
+  if (!(y > 0.0 && y < max_y)) {
+    y = std::clamp(y, 0.0, max_y);
+    dy = 0.0;
+  }
   const int x0 = std::min(static_cast<int>(x), image.cols - 2);
   const int y0 = std::min(static_cast<int>(y), image.rows - 2);
   const double u = x - x0, v = y - y0;
-  const cv::Vec3f* row0 = image.ptr<cv::Vec3f>(y0);
-  const cv::Vec3f* row1 = image.ptr<cv::Vec3f>(y0 + 1);
-  BilinearRead read;
+  const float* top = image.ptr<float>(y0) + 3 * x0;
+  const float* bottom = image.ptr<float>(y0 + 1) + 3 * x0;
   for (int channel = 0; channel < 3; ++channel) {
-    const double c00 = row0[x0][channel], c10 = row0[x0 + 1][channel];
-    const double c01 = row1[x0][channel], c11 = row1[x0 + 1][channel];
-    const double top = c00 + u * (c10 - c00), bottom = c01 + u * (c11 - c01);
-    read.color[channel] = top + v * (bottom - top);
-    read.dx[channel] = inside_x ? (1.0 - v) * (c10 - c00) + v * (c11 - c01) : 0.0;
-    read.dy[channel] = inside_y ? bottom - top : 0.0;
+    const double c00 = top[channel], c10 = top[channel + 3];
+    const double c01 = bottom[channel], c11 = bottom[channel + 3];
+    const double along_top = c10 - c00, along_bottom = c11 - c01;
+    const double upper = c00 + u * along_top, lower = c01 + u * along_bottom;
+    color[channel] = upper + v * (lower - upper);
+    if (derivative != nullptr) {
+      derivative[channel] =
+          dx * (along_top + v * (along_bottom - along_top)) + dy * (lower - upper);
+    }
   }
-  return read;
 }
 
 }  // namespace
@@ -53,12 +56,23 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
       samples_(samples),
       cameras_(cameras) {
   for (const CameraInput& camera : cameras) {
+    projections_.emplace_back();
+    projections_.back() << camera.camera.K * camera.camera.R, camera.camera.K * camera.camera.t;
     Require(camera.pixels.type() == CV_32FC3 && camera.pixels.cols >= 2 && camera.pixels.rows >= 2,
             camera.camera.name, "the samples need the camera's image, converted (CV_32FC3)");
     Require(camera.samples_visible.size() == static_cast<size_t>(samples.size()),
             camera.camera.name, "visibility must have one flag per surface sample");
   }
-  for (int s = 0; s < static_cast<int>(samples.patches.size()); ++s) {
+  // Patches added in the order of their centres in space, so that the blocks a thread evaluates
+  // one after the other read the same rows of the images and mostly the same samples: the reads
+  // then come from the caches, not memory.
+  const int num_patches = static_cast<int>(samples.patches.size());
+  Eigen::Matrix3Xd centres(3, num_patches);
+  for (int s = 0; s < num_patches; ++s) {
+    centres.col(s) = samples.patches[s].empty() ? Eigen::Vector3d::Constant(std::nan(""))
+                                                : samples.base.col(samples.patches[s][0]).eval();
+  }
+  for (int s : SpatialOrder(centres)) {
     const std::vector<int>& patch = samples.patches[s];
     if (static_cast<int>(patch.size()) < kMinPatchSamples) continue;
     std::vector<int> seen_by;
@@ -73,16 +87,18 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
   WeighPatches();
 }
 
-Eigen::Vector3d PixelConsensusSimilarity::SampleColor(int c, int j, double k,
-                                                      Eigen::Vector3d* derivative) const {
-  const CameraInput& camera = cameras_[c];
-  const ProjectedGaussian projected = ProjectSurfaceGaussian(
-      camera.camera, samples_.base.col(j), samples_.normals.col(j), k, /*sigma_hat=*/0.0);
-  const BilinearRead read = ReadBilinear(camera.pixels, projected.mean.x(), projected.mean.y());
-  if (derivative != nullptr) {
-    *derivative = read.dx * projected.dmean_dk.x() + read.dy * projected.dmean_dk.y();
-  }
-  return read.color;
+void PixelConsensusSimilarity::SampleColor(int c, int j, double k, double* color,
+                                           double* derivative) const {
+  // The sample's homogeneous pixel h(k) = P (base + k normal): a straight line, so that the pixel
+  // h_xy / h_z and its k-derivative (h'_xy - pixel h'_z) / h_z need no more than it.
+  const Eigen::Matrix<double, 3, 4>& projection = projections_[c];
+  const Eigen::Vector3d direction = projection.leftCols<3>() * samples_.normals.col(j);
+  const Eigen::Vector3d h =
+      projection.leftCols<3>() * samples_.base.col(j) + projection.col(3) + k * direction;
+  const double inverse_depth = 1.0 / h.z();
+  const double x = h.x() * inverse_depth, y = h.y() * inverse_depth;
+  ReadBilinear(cameras_[c].pixels, x, y, (direction.x() - x * direction.z()) * inverse_depth,
+               (direction.y() - y * direction.z()) * inverse_depth, color, derivative);
 }
 
 void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
@@ -94,12 +110,8 @@ void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
     const int c = Cameras(b)[a];
     for (int m = 0; m < n; ++m) {
       const int i = a * n + m;
-      Eigen::Vector3d derivative;
-      const Eigen::Vector3d color =
-          SampleColor(c, members[m], k + shape_[members[m]] - centre_shape,
-                      derivatives != nullptr ? &derivative : nullptr);
-      Eigen::Map<Eigen::Vector3d>(colors + 3 * i) = color;
-      if (derivatives != nullptr) Eigen::Map<Eigen::Vector3d>(derivatives + 3 * i) = derivative;
+      SampleColor(c, members[m], k + shape_[members[m]] - centre_shape, colors + 3 * i,
+                  derivatives != nullptr ? derivatives + 3 * i : nullptr);
     }
   }
 }

@@ -46,15 +46,16 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // SurfaceSamples::weights: sample j of patch s is read at k_s + shape_j - shape_s.
   void SetPatchShape(const Eigen::VectorXd& shape) override;
 
-  // Camera c's colour of sample j displaced by k along its normal, and dcolour/dk when
-  // `derivative` is not null.
-  Eigen::Vector3d SampleColor(int c, int j, double k, Eigen::Vector3d* derivative) const;
-
  private:
   void PatchColors(int b, double k, double* colors, double* derivatives) const override;
+  // Writes camera c's colour of sample j displaced by k along its normal (three channels) to
+  // `color` and, when `derivative` is not null, dcolour/dk to it.
+  void SampleColor(int c, int j, double k, double* color, double* derivative) const;
 
   const SurfaceSamples& samples_;
   const std::vector<CameraInput>& cameras_;
+  // Per camera, K [R | t]: the homogeneous pixel of a world point (the images are undistorted).
+  std::vector<Eigen::Matrix<double, 3, 4>> projections_;
   Eigen::VectorXd shape_;            // Per sample.
   Eigen::VectorXd parameter_shape_;  // Per surface Gaussian.
 };

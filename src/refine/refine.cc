@@ -133,32 +133,6 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 namespace {
 
-// Replaces the energy of a solved frame by the one that reads its images at their own
-// resolution (ConsensusOptions::sample_spacing) over the same surface Gaussians, with the
-// visibility the frame was prepared with.
-void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
-                         const RefineOptions& options, PreparedFrame* frame) {
-  const auto start = std::chrono::steady_clock::now();
-  const ConsensusOptions& consensus = options.energy.consensus;
-  SurfaceGaussians surface = frame->energy->surface();
-  frame->energy.reset();  // Its pair lists and tables are not needed any more.
-  const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
-  SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
-                                         model.neighbourhoods(), consensus.patch_rings, levels);
-  const std::vector<cv::Mat> pixels =
-      SampledImages(input, options.image.color_space, consensus.sample_blur);
-  std::vector<CameraInput> cameras(input.cameras.size());
-  for (size_t c = 0; c < cameras.size(); ++c) {
-    cameras[c].camera = input.cameras[c];
-    for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
-    cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
-    cameras[c].pixels = pixels[c];
-  }
-  frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                                options.energy, std::move(samples));
-  frame->seconds += SecondsSince(start);
-}
-
 // PrepareFrame without checking `options`, over the image models `images` of the input's images
 // under options.image: the coarse levels of a schedule widen sigma_hat and the leaves past the
 // ranges that a configured value must lie in.
@@ -220,6 +194,29 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
   }
   frame.seconds = SecondsSince(start);
   return frame;
+}
+
+void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
+                         const RefineOptions& options, PreparedFrame* frame) {
+  const auto start = std::chrono::steady_clock::now();
+  const ConsensusOptions& consensus = options.energy.consensus;
+  SurfaceGaussians surface = frame->energy->surface();
+  frame->energy.reset();  // Its pair lists and tables are not needed any more.
+  const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
+  SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
+                                         model.neighbourhoods(), consensus.patch_rings, levels);
+  const std::vector<cv::Mat> pixels =
+      SampledImages(input, options.image.color_space, consensus.sample_blur);
+  std::vector<CameraInput> cameras(input.cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    cameras[c].camera = input.cameras[c];
+    for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
+    cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
+    cameras[c].pixels = pixels[c];
+  }
+  frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
+                                                options.energy, std::move(samples));
+  frame->seconds += SecondsSince(start);
 }
 
 bool ReadsImagesAfterPreparation(const RefineOptions& options) {

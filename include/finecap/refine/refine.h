@@ -222,6 +222,14 @@ struct PreparedFrame {
 PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options);
 
+// Replaces the energy of a prepared (and usually solved) frame by the one that reads the input's
+// images at their own resolution over the same surface Gaussians (ConsensusOptions::
+// sample_spacing), with the visibility the frame was prepared with: the
+// detail stage RefineFrame solves last. Its patches start unshaped (SimilarityTerm::
+// SetPatchShape).
+void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
+                         const RefineOptions& options, PreparedFrame* frame);
+
 // PrepareFrame at the level RefineFrame solves last, with the plane sweep's start when that level
 // starts from it (no coarse-to-fine schedule): what RefineFrame does to a frame before it solves
 // and what does not depend on any other frame, so that a sequence can do it while the frame before
