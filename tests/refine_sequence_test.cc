@@ -10,6 +10,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
@@ -69,6 +70,43 @@ TEST(RefineSequenceTest, TheFrameAfterAKeptInputStartsWhereAFirstFrameStarts) {
   ASSERT_TRUE(std::isfinite(first.energy_start));
   EXPECT_EQ(after_kept.energy_start, first.energy_start);
   EXPECT_EQ(after_kept.kept_input, first.kept_input);
+}
+
+// What refine writes depends on the training views alone: a held-out view is scored, never solved
+// against, so with refine.keep_input_if_worse off (with it on, the score decides by design) its
+// pixels may change without changing a byte of the meshes or displacements written.
+TEST(RefineSequenceTest, HeldOutImagesDoNotChangeWhatIsWritten) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_heldout_blind");
+  const std::string capture = root + "/capture";
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), capture);
+  Config config = testing_util::TinyRunConfig(capture, root + "/seen", 5);
+  config.eval.flow = "none";
+  config.validation.cameras = {"cam05"};
+  ASSERT_FALSE(config.refine.keep_input_if_worse);  // The default.
+  ASSERT_EQ(RunRefine(config), 0);
+
+  // The held-out camera's images replaced by their negatives.
+  for (const auto& entry : fs::directory_iterator(capture + "/images/cam05")) {
+    const cv::Mat image = cv::imread(entry.path().string());
+    ASSERT_FALSE(image.empty()) << entry.path();
+    cv::imwrite(entry.path().string(), cv::Scalar::all(255) - image);
+  }
+  Config negative = config;
+  negative.output.dir = root + "/negative";
+  ASSERT_EQ(RunRefine(negative), 0);
+
+  for (const std::string frame : {"000000", "000001"}) {
+    const FrameFiles seen = FrameFilesIn(config.output.dir, frame, MeshFormat::kPly);
+    const FrameFiles blind = FrameFilesIn(negative.output.dir, frame, MeshFormat::kPly);
+    EXPECT_EQ(FileBytes(seen.mesh), FileBytes(blind.mesh)) << frame;
+    EXPECT_EQ(FileBytes(seen.displacement), FileBytes(blind.displacement)) << frame;
+    // The negatives were read: they score differently.
+    const double seen_score = Record(config.output.dir, frame).heldout_ncc_refined;
+    const double blind_score = Record(negative.output.dir, frame).heldout_ncc_refined;
+    ASSERT_TRUE(std::isfinite(seen_score) && std::isfinite(blind_score)) << frame;
+    EXPECT_NE(seen_score, blind_score) << frame;
+  }
 }
 
 // Counts what RefineSequence reports.
