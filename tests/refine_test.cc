@@ -170,5 +170,22 @@ TEST(CoarseToFineOptionsTest, RefusesLevelsAndScalesOutOfRange) {
                                     {"CoarseToFineOptions::scale", "[1.0001, 4]"});
 }
 
+// A patch covers the same surface at every subdivision level: its rings double with each level
+// past the first, up to the widest patch.
+TEST(PatchRingsTest, CountEdgesOfTheInputSubdividedOnce) {
+  RefineOptions options;
+  const auto rings_at = [&](int patch_rings, int levels) {
+    options.energy.consensus.patch_rings = patch_rings;
+    options.subdivision_levels = levels;
+    return PatchRingsAt(options);
+  };
+  EXPECT_EQ(rings_at(1, 0), 1);
+  EXPECT_EQ(rings_at(1, 1), 1);
+  EXPECT_EQ(rings_at(1, 2), 2);
+  EXPECT_EQ(rings_at(1, 3), 4);
+  EXPECT_EQ(rings_at(2, 1), 2);
+  EXPECT_EQ(rings_at(2, 3), ConsensusOptions::kMaxPatchRings);
+}
+
 }  // namespace
 }  // namespace finecap

@@ -217,8 +217,9 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                  0, 100);
   schema->AddInt("energy.consensus.patch_rings", &energy->consensus.patch_rings,
                  "Consensus similarity: a patch is a surface Gaussian and its neighbours up to "
-                 "this many edges away (at most energy.reg_rings).",
-                 1, 4);
+                 "this many edges of the input subdivided once away (patch_rings x "
+                 "2^(model.subdivision_levels - 1) edges of the refined mesh, at most 4).",
+                 1, ConsensusOptions::kMaxPatchRings);
   schema->AddBool("energy.consensus.gain_per_channel", &energy->consensus.gain_per_channel,
                   "Consensus similarity: normalise each camera's gain per channel (white "
                   "balance) instead of once for all channels (exposure).");

@@ -46,7 +46,7 @@ void ConsensusOptions::Check() const {
   RequireFieldRange(min_cameras, 2, 64, "ConsensusOptions::min_cameras");
   RequireFieldRange(passes, 1, 10, "ConsensusOptions::passes");
   RequireFieldRange(shape_smoothing_rounds, 0, 100, "ConsensusOptions::shape_smoothing_rounds");
-  RequireFieldRange(patch_rings, 1, 4, "ConsensusOptions::patch_rings");
+  RequireFieldRange(patch_rings, 1, kMaxPatchRings, "ConsensusOptions::patch_rings");
   RequireFieldRange(robust_fraction, 0.0, 100.0, "ConsensusOptions::robust_fraction");
   RequireFieldRange(sample_spacing, 0.0, 16.0, "ConsensusOptions::sample_spacing");
   RequireFieldRange(sample_blur, 0.0, 8.0, "ConsensusOptions::sample_blur");

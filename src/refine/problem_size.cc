@@ -67,10 +67,10 @@ constexpr double kBytesPerSampledPixel = 12.0;
 constexpr double kBytesPerSurfaceSample = 110.0;
 constexpr double kSecondsPerSampleRead = 0.35e-6;
 
-// The samples of a regular vertex's patch after `levels` of linear subdivision: the hexagon of
-// radius 2^levels without its rim.
-int SamplesPerRegularPatch(int levels) {
-  const int radius = 1 << levels;
+// The samples of a regular vertex's patch of `rings` rings after `levels` of linear subdivision:
+// the hexagon of radius rings * 2^levels without its rim.
+int SamplesPerRegularPatch(int rings, int levels) {
+  const int radius = rings << levels;
   return 1 + 3 * (radius - 1) * radius;
 }
 
@@ -124,7 +124,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   if (consensus && options.energy.consensus.sample_spacing > 0.0) {
     const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
     size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
-    size.samples_per_patch = SamplesPerRegularPatch(levels);
+    size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
     detail_bytes =
         size.num_pixels * kBytesPerSampledPixel + size.num_surface_samples * kBytesPerSurfaceSample;
     detail_seconds = size.num_observations * double(size.samples_per_patch) * kSecondsPerSampleRead;

@@ -40,6 +40,13 @@ bool UsesSurfaceSamples(const RefineOptions& options) {
          options.energy.consensus.sample_spacing > 0.0;
 }
 
+// The energy's options with the patch's rings counted on the refined mesh (PatchRingsAt).
+EnergyOptions EnergyOptionsAt(const RefineOptions& options) {
+  EnergyOptions energy = options.energy;
+  energy.consensus.patch_rings = PatchRingsAt(options);
+  return energy;
+}
+
 const RefineOptions& Checked(const RefineOptions& options) {
   options.Check();
   return options;
@@ -83,7 +90,9 @@ SequenceModel::SequenceModel(const Mesh& first_coarse, const std::vector<int>& c
       num_coarse_vertices_(first_coarse.num_vertices()) {
   refined_vertices_ = FineMaskIds(stencil_, coarse_mask, num_coarse_vertices_);
   const Mesh fine = ApplySubdivision(stencil_, first_coarse.vertices);
-  neighbourhoods_ = BuildVertexNeighbourhoods(fine, options.energy.reg_rings, where);
+  // Far enough for the regulariser and for the widest patch.
+  neighbourhoods_ = BuildVertexNeighbourhoods(
+      fine, std::max(options.energy.reg_rings, PatchRingsAt(options)), where);
 }
 
 std::vector<int> SequenceModel::SubdivideIds(const std::vector<int>& coarse_ids) const {
@@ -167,7 +176,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
     frame.num_image_gaussians += frame.images[c].size();
   }
   frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                               options.energy);
+                                               EnergyOptionsAt(options));
   if (!frame.energy->similarity().ReadsPairLists())
     std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
@@ -204,7 +213,7 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
   frame->energy.reset();  // Its pair lists and tables are not needed any more.
   const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
   SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
-                                         model.neighbourhoods(), consensus.patch_rings, levels);
+                                         model.neighbourhoods(), PatchRingsAt(options), levels);
   const std::vector<cv::Mat> pixels =
       SampledImages(input, options.image.color_space, consensus.sample_blur);
   std::vector<CameraInput> cameras(input.cameras.size());
@@ -215,7 +224,7 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     cameras[c].pixels = pixels[c];
   }
   frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                                options.energy, std::move(samples));
+                                                EnergyOptionsAt(options), std::move(samples));
   frame->seconds += SecondsSince(start);
 }
 
@@ -368,6 +377,12 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
 }
 
 }  // namespace
+
+int PatchRingsAt(const RefineOptions& options) {
+  const int doublings = std::max(options.subdivision_levels - 1, 0);
+  return std::min(options.energy.consensus.patch_rings << doublings,
+                  ConsensusOptions::kMaxPatchRings);
+}
 
 double BiasCompensation(const RefineOptions& options) {
   return options.bias_compensation ? options.sigma_hat : 0.0;

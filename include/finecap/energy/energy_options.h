@@ -39,8 +39,11 @@ struct ConsensusOptions {
   // shaped by its one-ring average; folds keep their shape, being longer than a patch).
   // 0: the displacement as found. Default 1.
   int shape_smoothing_rounds = 1;
-  // Size of a patch: a surface Gaussian and its neighbours up to this many mesh edges away (at
-  // most energy.reg_rings, the neighbourhoods built). Default 1.
+  static constexpr int kMaxPatchRings = 4;
+
+  // Size of a patch: a surface Gaussian and its neighbours up to this many mesh edges away, in
+  // [1, kMaxPatchRings]. A refinement counts them in edges of its input subdivided once
+  // (PatchRingsAt in refine.h). Default 1.
   int patch_rings = 1;
   // Whether each camera's gain is normalised per channel (white balance) or once for all three
   // (exposure; its offsets stay per channel). Default true.
