@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include <glog/logging.h>
 
 #include "finecap/energy/frame_energy.h"
 #include "finecap/model/gaussian_pairs.h"
+#include "finecap/util/error.h"
 #include "refine/surface_sampling.h"
 
 namespace finecap {
@@ -141,10 +143,33 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   // What a refit of the constants needs beside each run's measured peak.
   VLOG(1) << "memory forecast of " << frames_held << " frame(s) held: " << size.num_pixels
           << " pixels, " << size.num_pairs << " pairs, " << size.num_observations
-          << " observations of " << size.num_surface_gaussians << " surface Gaussians";
+          << " observations of " << size.num_surface_gaussians << " surface Gaussians, "
+          << size.samples_per_patch << " samples a patch";
   size.seconds_per_frame = size.num_pairs * kSecondsPerPair +
                            size.num_surface_gaussians * kSecondsPerSurfaceGaussian + detail_seconds;
   return size;
+}
+
+void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,
+                      int max_memory_mb, const AvailableMemory& available) {
+  const bool own_limit = max_memory_mb > 0 && max_memory_mb < available.megabytes;
+  const double limit = own_limit ? max_memory_mb : available.megabytes;
+  if (!(size.peak_memory_mb > limit)) return;
+  std::ostringstream problem;
+  problem.precision(2);
+  problem << std::fixed << "the forecast peak memory of this run, "
+          << std::lround(size.peak_memory_mb) << " MB, exceeds the " << std::lround(limit) << " MB "
+          << (own_limit ? "it is allowed" : "available to it")
+          << "; lower RefineOptions::subdivision_levels (now " << options.subdivision_levels
+          << ", each level about 4 times the surface), the size of the images ("
+          << size.num_pixels / 1e6 << " Mpixel a frame over " << size.visible_per_camera.size()
+          << " cameras)";
+  if (num_frames > 1) {
+    problem << " or the frames held at once (a run of several frames prepares two ahead, three "
+               "frames' worth; one frame a run, --frames I:I+1, holds one)";
+  }
+  problem << (own_limit ? ", or raise SequenceOptions::max_memory_mb" : ", or free memory for it");
+  throw Error(own_limit ? "SequenceOptions::max_memory_mb" : available.source, problem.str());
 }
 
 double UndistortedPixels(const Capture& capture) {
