@@ -75,6 +75,7 @@ awk -v r="$growth" 'BEGIN { exit !(r <= 1.10) }' ||
 half_frame=$(echo "$seconds $frames" | awk '{ printf "%.3f", 0.5 * $1 / $2 }')
 resumed=$work/resumed
 rm -rf "$resumed"
+: >"$work/resumed.log"
 kills=0
 next_kill=$kill_every
 start=$(now)
