@@ -181,6 +181,30 @@ TEST(CliTest, InfoForecastsTheMemoryRefinePrints) {
   EXPECT_EQ(NumberAfter(refine.output, "expected peak memory "), forecast) << refine.output;
 }
 
+// A run whose memory forecast exceeds runtime.max_memory_mb is refused before it starts: one
+// message with the forecast and what to lower, exit 1, no output folder. Within the limit it runs.
+TEST(CliTest, RefineRefusesARunForecastAboveTheMemoryLimit) {
+  const fs::path capture = TinyCapture("memory_limit");
+  const fs::path out = capture / ".." / "out";
+  const RunResult refused = RunFinecap("refine --capture " + capture.string() + " --out " +
+                                       out.string() + " --set runtime.max_memory_mb=1");
+  EXPECT_EQ(refused.exit_code, 1) << refused.output;
+  for (const char* part : {"finecap: error: runtime.max_memory_mb: the forecast peak memory of "
+                           "this run, ",
+                           "MB, exceeds the 1 MB it is allowed", "model.subdivision_levels",
+                           "the size of the images", "or raise runtime.max_memory_mb"}) {
+    EXPECT_NE(refused.output.find(part), std::string::npos) << part << "\n" << refused.output;
+  }
+  EXPECT_EQ(refused.output.find("expected peak memory"), std::string::npos) << refused.output;
+  EXPECT_FALSE(fs::exists(out));
+
+  const RunResult within =
+      RunFinecap("refine --capture " + capture.string() + " --out " + out.string() +
+                 " --set runtime.max_memory_mb=100000,solver.max_iterations=1");
+  EXPECT_EQ(within.exit_code, 0) << within.output;
+  EXPECT_TRUE(fs::exists(out / "stats.jsonl"));
+}
+
 TEST(CliTest, InfoWarnsAboutVerticesNoCameraSees) {
   const fs::path capture = TinyCapture("info_unseen");
   const RunResult result =

@@ -9,6 +9,7 @@
 #include "finecap/io/capture.h"
 #include "finecap/model/gaussian_pairs.h"
 #include "finecap/synth/synth.h"
+#include "finecap/util/error.h"
 #include "refine/scene_scale.h"
 #include "test_util.h"
 #include "tiny_synth.h"
@@ -120,6 +121,34 @@ TEST_F(ProblemSizeTest, UndistortedImagesTakeMoreMemory) {
   const ProblemSize undistorted = EstimateProblemSize(model, colors, input_, options, 1, 1e6);
   EXPECT_GT(undistorted.peak_memory_mb, plain.peak_memory_mb + 1.0);
   EXPECT_EQ(undistorted.num_pairs, plain.num_pairs);
+}
+
+// A forecast above the run's own limit or above what the system has is refused with the figure,
+// the limit and what to lower; one within both is not.
+TEST(RequireMemoryForTest, RefusesAForecastAboveEitherLimit) {
+  ProblemSize size;
+  size.peak_memory_mb = 812.4;
+  size.num_pixels = 4 * 96.0 * 96.0;
+  size.visible_per_camera = {1, 1, 1, 1};
+  RefineOptions options;
+  const AvailableMemory plenty{64000.0, "/proc/meminfo"};
+  EXPECT_NO_THROW(RequireMemoryFor(size, 3, options, 0, plenty));
+  EXPECT_NO_THROW(RequireMemoryFor(size, 3, options, 900, plenty));
+  testing_util::ExpectErrorMentions([&] { RequireMemoryFor(size, 3, options, 500, plenty); },
+                                    {"SequenceOptions::max_memory_mb", "812 MB", "500 MB",
+                                     "RefineOptions::subdivision_levels (now 1",
+                                     "0.04 Mpixel a frame over 4 cameras", "frames held at once"});
+  // One frame: nothing is prepared ahead, so the frames held are not named.
+  try {
+    RequireMemoryFor(size, 1, options, 500, plenty);
+    ADD_FAILURE() << "expected an Error";
+  } catch (const Error& error) {
+    EXPECT_EQ(std::string(error.what()).find("frames held"), std::string::npos) << error.what();
+  }
+  // The system's figure, named by its file, when it is the smaller.
+  const AvailableMemory scarce{600.0, "/sys/fs/cgroup/memory.max"};
+  testing_util::ExpectErrorMentions([&] { RequireMemoryFor(size, 1, options, 700, scarce); },
+                                    {"/sys/fs/cgroup/memory.max", "812 MB", "600 MB available"});
 }
 
 }  // namespace

@@ -100,7 +100,7 @@ std::string RoundedSeconds(double seconds) {
   return text.str();
 }
 
-std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
+std::string CheckOutputFolder(const Config& config, const Capture& capture) {
   Require(!config.output.dir.empty(), "output.dir",
           "no output folder given (set output.dir or pass --out DIR)");
   const fs::path out = fs::weakly_canonical(config.output.dir);
@@ -108,6 +108,11 @@ std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
   const auto [mismatch, unused] = std::mismatch(in.begin(), in.end(), out.begin(), out.end());
   Require(mismatch != in.end(), config.output.dir,
           "the output folder may not be the capture folder or lie inside it");
+  return out.string();
+}
+
+std::string PrepareOutputFolder(const Config& config, const Capture& capture) {
+  const fs::path out = CheckOutputFolder(config, capture);
   std::error_code error;
   fs::create_directories(out, error);
   // A concurrent shard may create it at the same moment: what matters is that it exists.
@@ -133,6 +138,7 @@ SequenceOptions SequenceOptionsOf(const Config& config) {
   options.held_out_score = config.validation.score;
   options.skip_unreadable_cameras = config.capture.skip_unreadable_cameras;
   options.mesh_format = MeshFormatOf(config);
+  options.max_memory_mb = config.runtime.max_memory_mb;
   return options;
 }
 

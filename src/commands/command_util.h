@@ -26,8 +26,11 @@ Capture OpenConfiguredCapture(const Config& config);
 // The configured frames of `capture`; an Error when the range holds none of its frames.
 FrameRange ConfiguredFrames(const Config& config, const Capture& capture);
 
-// Creates config.output.dir (and its parents) unless it exists; refuses the capture folder
-// itself or a folder inside it, so that nothing a user gave is ever written over.
+// config.output.dir as an absolute path, without creating it; refuses the capture folder itself
+// or a folder inside it, so that nothing a user gave is ever written over.
+std::string CheckOutputFolder(const Config& config, const Capture& capture);
+
+// CheckOutputFolder, and creates the folder (and its parents) unless it exists.
 std::string PrepareOutputFolder(const Config& config, const Capture& capture);
 
 // output.dir of a previous `finecap refine`, which must exist (nothing is created).

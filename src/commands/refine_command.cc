@@ -10,7 +10,8 @@ int RunRefine(const Config& configured) {
   const FrameRange frames =
       ShardOf(internal::ConfiguredFrames(configured, capture), configured.runtime.shard);
   const Config config = internal::WithSceneLengths(configured, capture, "refine");
-  const std::string out = internal::PrepareOutputFolder(config, capture);
+  // Created by the run, once its memory forecast has been found to fit.
+  const std::string out = internal::CheckOutputFolder(config, capture);
   internal::RefineConfiguredSequence(config, frames, out, "refine", &capture);
   return 0;
 }

@@ -115,6 +115,12 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
         config->runtime.shard = ParseShard(value.Scalar(), where);
       },
       [config] { return config->runtime.shard.ToString(); });
+  schema->AddInt(
+      "runtime.max_memory_mb", &config->runtime.max_memory_mb,
+      "finecap refine: refuse, before it starts, a run whose forecast peak memory "
+      "exceeds this many MB; 0 = the memory available (the smaller of the cgroup limit and "
+      "MemAvailable), which is always checked.",
+      0);
   schema->AddInt("eval.camera", &config->eval.camera,
                  "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
   schema->AddChoice("eval.flow", &config->eval.flow,
@@ -368,6 +374,7 @@ bool IsKeyOrPart(const std::string& path, const ConfigSchema& schema) {
 const std::map<std::string, std::string>& RenamedFields() {
   static const std::map<std::string, std::string> renamed = {
       {"SequenceOptions::held_out_cameras", "validation.cameras"},
+      {"SequenceOptions::max_memory_mb", "runtime.max_memory_mb"},
       {"RunEvaluationOptions::held_out_cameras", "validation.cameras"}};
   return renamed;
 }

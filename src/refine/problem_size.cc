@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include <glog/logging.h>
 
 #include "finecap/energy/frame_energy.h"
 #include "finecap/model/gaussian_pairs.h"
+#include "finecap/util/error.h"
 #include "refine/surface_sampling.h"
 
 namespace finecap {
@@ -19,11 +21,12 @@ namespace {
 // the time of counting them all, which the forecast once did on every camera of the first frame.
 constexpr int kSampledSurfaceGaussians = 1000;
 
-// The peak resident memory of a run, fitted (least squares, non-negative) to 18 refinements on 2
-// cores (bench/memory_forecast.sh and the same runs by hand: synth_demo with 512 and 128 pixel
-// cameras and with two subdivision levels, synth_skirt with 8 and 4 cameras, a wider k_max and a
-// smaller sigma_hat, the surface_color similarity, the Middlebury temple with
-// and without held-out cameras and with a smaller k_max; one frame and three; 42 to 289 MB): all
+// The peak resident memory of a run without the detail stage (below), fitted (least squares,
+// non-negative) to 18 refinements on 2 cores (bench/memory_forecast.sh and the same runs by hand:
+// synth_demo with 512 and 128 pixel cameras and with two subdivision levels, synth_skirt with 8
+// and 4 cameras, a wider k_max and a smaller sigma_hat, the surface_color similarity, the
+// Middlebury temple with and without held-out cameras and with a smaller k_max; one frame and
+// three; 42 to 289 MB): all
 // within 0.86-1.19 of their measured peaks, and within 0.84-1.16 when each is left out of the fit
 // (the default similarity; the surface_color similarity, three runs, 0.72-1.27).
 constexpr double kBaseMegabytes = 29.0;  // The process: code, libraries, thread stacks, allocator.
@@ -51,21 +54,45 @@ constexpr double kBytesPerSurfaceGaussianCholesky = 400.0;  // synth_skirt: 104 
 // 173 MB for three).
 constexpr int kFramesHeldBySeveral = 3;
 
-// Seconds of one frame: the pairs dominate large problems (the colour tables and pair lists run
-// over them), the solver's work per Gaussian small ones. Refitted to the first frames of
-// bench/memory_forecast.sh's three captures (synth_demo 0.2 s, synth_skirt 0.5 s, the temple
-// 2.9 s on the idle machine): within a factor of 2 of each.
+// Seconds of one frame without the detail stage: the pairs dominate large problems (the colour
+// tables and pair lists run over them), the solver's work per Gaussian small ones. Refitted to the
+// first frames of bench/memory_forecast.sh's three captures (synth_demo 0.2 s, synth_skirt 0.5 s,
+// the temple 2.9 s on the idle machine): within a factor of 2 of each.
 constexpr double kSecondsPerPair = 0.16e-6;
 constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 
-// The detail stage (ConsensusOptions::sample_spacing): each camera's image as 3 floats a pixel,
-// and per surface sample its position, direction, blend weights and visibility; its time, per
-// sample read in a patch in one camera, over the ~25 evaluations of its two passes
-// (synth_skirt: 0.6 s a frame for 1.7 M reads an evaluation, 2 cores). Not refitted: from one
-// capture.
-constexpr double kBytesPerSampledPixel = 12.0;
-constexpr double kBytesPerSurfaceSample = 110.0;
-constexpr double kSecondsPerSampleRead = 0.35e-6;
+// With the detail stage (ConsensusOptions::sample_spacing, the default), which the constants above
+// predate: the forecast of 2026-12-04 held none of the real captures (measured / forecast: the
+// temple 0.71, Sceaux 0.86, Sceaux at full resolution 0.79 for memory; 2.0 for time at full
+// resolution), so the default path has constants of its own, fitted to 9 runs on 2 cores: the
+// first frame of synth_demo (4 cameras of 512 px, 3 sample levels), synth_skirt (8 cameras of
+// 1004 px; one frame, and two with three frames held), the Middlebury temple (16 cameras, and 12
+// with configs/temple.yaml), Sceaux (10 cameras of 708 x 532, and 8 with its heldout.yaml), Sceaux
+// at full resolution (8 of 2832 x 2128, 4 sample levels, bench/sceaux_full_resolution.sh) and the
+// soak's capture (bench/soak.sh: 6 cameras of 80 px, three frames held); 31 MB to 2.7 GB.
+//
+// Memory: the worst ratio made smallest (a grid over the three constants below, the process's
+// 29 MB and the colour tables, an exact count, held fixed), over the 9 runs and a second run of
+// 4 of them (peaks move by up to 8 % from run to run): all within 0.85-1.18 of their measured
+// peaks. Each camera's image as 3 floats a pixel, blurred, and what reading and preparing it
+// holds; per pair while the pairs are built; per surface sample its position, direction, blend
+// weights and visibility. The surface Gaussians' own share (kBytesPerSurfaceGaussian) fitted to
+// zero in a least-squares fit with it free: the other terms hold it. synth_demo is the only run
+// with 3 sample levels (169 samples a patch): left out of that least-squares fit, it came out at
+// 2.4 times its forecast, so a capture sampled that finely is forecast from one run.
+constexpr double kBytesPerSampledPixel = 9.8;  // Beside kBytesPerPixel's 4.2.
+constexpr double kBytesPerConsensusPairWithSamples = 1.0;
+constexpr double kBytesPerSurfaceGaussianWithSamples = 0.0;
+constexpr double kBytesPerSurfaceSample = 205.0;
+// Time, measured as the frame's CPU seconds over 2 cores (the machine was shared, wall clocks 2
+// to 4 times that), minimax on the log ratio: all 9 within 0.59-1.69. Per pair (the colour tables
+// are built over them), and per sample read in a patch in one camera over the evaluations of the
+// detail stage's two passes. The spread is real: a read in a full-resolution image (72 MB of
+// floats a camera) misses the caches that the 708 x 532 images fit in, and Sceaux at full
+// resolution, 135 M reads an evaluation against 7 M, takes 1.7 times its forecast while Sceaux
+// takes 0.6 times it; a model of the caches is left to do.
+constexpr double kSecondsPerPairWithSamples = 0.355e-6;
+constexpr double kSecondsPerSampleRead = 0.116e-6;
 
 // The samples of a regular vertex's patch of `rings` rings after `levels` of linear subdivision:
 // the hexagon of radius rings * 2^levels without its rim.
@@ -114,14 +141,17 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   }
 
   const bool consensus = options.energy.similarity == SimilarityType::kConsensus;
-  double per_frame = size.num_pairs * (consensus ? kBytesPerConsensusPair : kBytesPerPair);
+  const bool sampled = consensus && options.energy.consensus.sample_spacing > 0.0;
+  double per_frame = size.num_pairs * (sampled     ? kBytesPerConsensusPairWithSamples
+                                       : consensus ? kBytesPerConsensusPair
+                                                   : kBytesPerPair);
   if (consensus) {
     // Its colour tables: value and derivative, 3 floats each, per node.
     const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
     per_frame += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation);
   }
   double detail_bytes = 0.0, detail_seconds = 0.0;
-  if (consensus && options.energy.consensus.sample_spacing > 0.0) {
+  if (sampled) {
     const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
     size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
     size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
@@ -136,15 +166,42 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
       size.num_pixels * kBytesPerPixel + undistorted_pixels * kBytesPerUndistortedPixel +
       frames_held * per_frame + detail_bytes +
       size.num_surface_gaussians *
-          (kBytesPerSurfaceGaussian + (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
+          ((sampled ? kBytesPerSurfaceGaussianWithSamples : kBytesPerSurfaceGaussian) +
+           (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
-  // What a refit of the constants needs beside each run's measured peak.
+  size.seconds_per_frame = sampled ? size.num_pairs * kSecondsPerPairWithSamples + detail_seconds
+                                   : size.num_pairs * kSecondsPerPair +
+                                         size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
+  // What a refit of the constants needs beside each run's measured peak and time.
   VLOG(1) << "memory forecast of " << frames_held << " frame(s) held: " << size.num_pixels
-          << " pixels, " << size.num_pairs << " pairs, " << size.num_observations
-          << " observations of " << size.num_surface_gaussians << " surface Gaussians";
-  size.seconds_per_frame = size.num_pairs * kSecondsPerPair +
-                           size.num_surface_gaussians * kSecondsPerSurfaceGaussian + detail_seconds;
+          << " pixels, " << undistorted_pixels << " undistorted, " << size.num_pairs << " pairs, "
+          << size.num_observations << " observations of " << size.num_surface_gaussians
+          << " surface Gaussians, " << size.num_surface_samples << " surface samples, "
+          << size.samples_per_patch << " samples a patch; per frame " << per_frame / 1e6
+          << " MB, detail " << detail_bytes / 1e6 << " MB, " << (cholesky ? "Cholesky" : "CGNR");
   return size;
+}
+
+void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,
+                      int max_memory_mb, const AvailableMemory& available) {
+  const bool own_limit = max_memory_mb > 0 && max_memory_mb < available.megabytes;
+  const double limit = own_limit ? max_memory_mb : available.megabytes;
+  if (!(size.peak_memory_mb > limit)) return;
+  std::ostringstream problem;
+  problem.precision(2);
+  problem << std::fixed << "the forecast peak memory of this run, "
+          << std::lround(size.peak_memory_mb) << " MB, exceeds the " << std::lround(limit) << " MB "
+          << (own_limit ? "it is allowed" : "available to it")
+          << "; lower RefineOptions::subdivision_levels (now " << options.subdivision_levels
+          << ", each level about 4 times the surface), the size of the images ("
+          << size.num_pixels / 1e6 << " Mpixel a frame over " << size.visible_per_camera.size()
+          << " cameras)";
+  if (num_frames > 1) {
+    problem << " or the frames held at once (a run of several frames prepares two ahead, three "
+               "frames' worth; one frame a run, --frames I:I+1, holds one)";
+  }
+  problem << (own_limit ? ", or raise SequenceOptions::max_memory_mb" : ", or free memory for it");
+  throw Error(own_limit ? "SequenceOptions::max_memory_mb" : available.source, problem.str());
 }
 
 double UndistortedPixels(const Capture& capture) {

@@ -10,6 +10,7 @@
 #include "finecap/solvers/solver_trace.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
+#include "finecap/util/memory.h"
 #include "measure/ground_truth.h"
 #include "refine/scene_scale.h"
 
@@ -204,9 +205,23 @@ class SequenceRun {
   // The reader's work ahead uses this run's members.
   ~SequenceRun() { reader_.DropPending(); }
 
+  // The size of the first frame's problem and what it forecasts, before the long part of the
+  // run and before it writes anything: a run that would need more memory than it may take is
+  // refused here.
+  void ReportProblemSize(const FrameRange& frames) {
+    FrameReadAhead::Frame first = reader_.Take(frames.begin);
+    const ProblemSize size =
+        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine, frames.size(),
+                            UndistortedPixels(*capture_));
+    RequireMemoryFor(size, frames.size(), options_.refine, options_.max_memory_mb,
+                     ReadAvailableMemory());
+    observer_->Starting(frames.size(), first.input, size);
+    reader_.Keep(frames.begin, std::move(first));
+  }
+
   void Run(const FrameRange& frames, SequenceResult* result) {
     if (!FollowsColors(options_)) RequireNoFollowedColors();
-    ReportProblemSize(frames);
+    SaveColors();
     prepare_ahead_ = !FollowsColors(options_);
     double sum_coarse2 = 0.0, sum_subdivided2 = 0.0, sum_refined2 = 0.0;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
@@ -239,24 +254,30 @@ class SequenceRun {
     }
     FrameReadAhead::Frame reference = reader_.Take(frame);
     ReportSkipped(frame, reference.skipped);
-    ReferenceColors colors = SaveReferenceColors(model_, options_, capture_, reference.input, path);
+    // Saved by SaveColors, once the run is known to fit in memory.
+    ReferenceColors colors =
+        ComputeReferenceFrameColors(model_, options_, capture_, reference.input);
+    colors.recipe = ReferenceColorRecipe(options_);
+    colors_unsaved_ = true;
     reader_.Keep(frame, std::move(reference));
     return colors;
+  }
+
+  // Writes the reference colours this run computed, and takes them as saved, so that every run
+  // and shard on this folder starts from the very same colours; those of a shard that saved
+  // them first when there are.
+  void SaveColors() {
+    if (!colors_unsaved_) return;
+    const std::string path = ReferenceColorsPath(out_);
+    if (!fs::exists(path)) WriteReferenceColors(path, reference_colors_);
+    reference_colors_ = LoadOrComputeReferenceColors(model_, options_, capture_, path);
+    colors_unsaved_ = false;
   }
 
   void ReportSkipped(int frame, const std::vector<SkippedCamera>& skipped) {
     for (const SkippedCamera& camera : skipped) {
       observer_->CameraSkipped(capture_->frame_name(frame), camera);
     }
-  }
-
-  // The size of the first frame's problem and what it forecasts, before the long part of the run.
-  void ReportProblemSize(const FrameRange& frames) {
-    FrameReadAhead::Frame first = reader_.Take(frames.begin);
-    observer_->Starting(frames.size(), first.input,
-                        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine,
-                                            frames.size(), UndistortedPixels(*capture_)));
-    reader_.Keep(frames.begin, std::move(first));
   }
 
   bool Done(int frame) const {
@@ -390,10 +411,14 @@ class SequenceRun {
   // first frame measured for the forecast, nor when each frame's colours follow the frame before.
   // Before the reader, which reads the reference frame while the run is made.
   bool prepare_ahead_ = false;
+  // Whether the colours were computed by this run and are still to be written (SaveColors).
+  // Before the colours, which set it as they are made.
+  bool colors_unsaved_ = false;
   // Before the colours: the reference frame they are taken from is read by it and kept for the
   // run (FrameReadAhead::Keep).
   FrameReadAhead reader_;
-  const ReferenceColors reference_colors_;
+  // Computed by this run and not yet written (SaveColors), or read from the run folder.
+  ReferenceColors reference_colors_;
   const Regions regions_;
   // The solver's problem, taken over by each frame from the one before (SolverWorkspace).
   SolverWorkspace solver_workspace_;
@@ -405,6 +430,8 @@ void SequenceOptions::Check() const {
   refine.Check();
   colors.Check();
   held_out_score.Check();
+  Require(max_memory_mb >= 0, "SequenceOptions::max_memory_mb",
+          "must be >= 0 (0: the memory available), got " + std::to_string(max_memory_mb));
   Require(reference_frame >= 0, "SequenceOptions::reference_frame",
           "must be >= 0, got " + std::to_string(reference_frame));
   for (const std::string& camera : held_out_cameras) {
@@ -543,13 +570,23 @@ SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
   options.Check();
   SequenceObserver silent;
   if (observer == nullptr) observer = &silent;
-  const int stale = PrepareRunSubfolders(out, FollowsColors(options));
-  if (stale > 0) observer->StaleFilesRemoved(stale);
   const StatsLog log(out, capture->frame_names(), options.mesh_format);
-  log.Rebuild();
+  const auto prepare_folder = [&] {
+    const int stale = PrepareRunSubfolders(out, FollowsColors(options));
+    if (stale > 0) observer->StaleFilesRemoved(stale);
+    log.Rebuild();
+  };
   SequenceResult result;
-  if (frames.size() == 0) return result;
-  SequenceRun(capture, options, out, observer).Run(frames, &result);
+  if (frames.size() == 0) {
+    prepare_folder();
+    return result;
+  }
+  // The run is made and its memory forecast before the folder is touched: a refused run writes
+  // nothing.
+  SequenceRun run(capture, options, out, observer);
+  run.ReportProblemSize(frames);
+  prepare_folder();
+  run.Run(frames, &result);
   log.Rebuild();
   return result;
 }

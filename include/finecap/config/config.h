@@ -47,6 +47,10 @@ struct RuntimeConfig {
   // Which part of the configured frames this process refines ("I/N", 0-based; see shard.h), so
   // that N processes can share one output folder. Default 0/1: all of them.
   Shard shard;
+  // finecap refine refuses a run whose forecast peak memory exceeds this many megabytes, as it
+  // refuses one that exceeds the memory available (SequenceOptions::max_memory_mb). 0: only the
+  // memory available. Default 0.
+  int max_memory_mb = 0;
 };
 
 // How `finecap eval` evaluates a refined run.

@@ -20,6 +20,7 @@
 
 #include "finecap/io/capture.h"
 #include "finecap/refine/refine.h"
+#include "finecap/util/memory.h"
 
 namespace finecap {
 
@@ -65,6 +66,14 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
 // The pixels of `capture`'s cameras that have lens distortion, every one, held out or not: their
 // images are undistorted as they are read.
 double UndistortedPixels(const Capture& capture);
+
+// Throws Error, naming the forecast peak memory and what to lower, when `size`'s forecast (of a
+// run of `num_frames` frames) exceeds `max_memory_mb` (0: no limit of its own) or `available`: a
+// run that the kernel would kill halfway, or that would push the machine into swap, is better
+// refused before it starts. The forecast is good to about 25 % (problem_size.cc), so a run
+// forecast just above the limit may have fitted, and one just below may not.
+void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,
+                      int max_memory_mb, const AvailableMemory& available);
 
 }  // namespace finecap
 

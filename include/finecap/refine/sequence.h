@@ -83,6 +83,10 @@ struct SequenceOptions {
   bool skip_unreadable_cameras = false;
   // How the refined meshes are written. Default PLY.
   MeshFormat mesh_format = MeshFormat::kPly;
+  // A run whose forecast peak memory (EstimateProblemSize) exceeds this many megabytes, or the
+  // memory available to the process (ReadAvailableMemory), is refused before it reads more than
+  // its first frame or writes anything. 0: only the memory available. Default 0.
+  int max_memory_mb = 0;
 
   void Check() const;
 };
@@ -185,12 +189,13 @@ struct SequenceResult {
   double rms_refined_mm = 0.0;
 };
 
-// Refines frames [frames.begin, frames.end) of `capture` into the run folder `out`, which must
-// exist (its subfolders are created); frames already done there are skipped. The topology and the
+// Refines frames [frames.begin, frames.end) of `capture` into the run folder `out` (created with
+// its subfolders when missing); frames already done there are skipped. The topology and the
 // refined vertices are those of frame 0. Several processes may run on one folder at once with
 // disjoint frames (shards). Throws Error (options.Check(), unreadable input, a reference colour
-// file of another recipe) before a frame's files are written, never leaving one half-written.
-// `observer` may be null.
+// file of another recipe) before a frame's files are written, never leaving one half-written; a
+// run whose memory forecast exceeds what it may use (SequenceOptions::max_memory_mb,
+// RequireMemoryFor) throws before it creates or writes anything in `out`. `observer` may be null.
 SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
                               const SequenceOptions& options, const std::string& out,
                               SequenceObserver* observer = nullptr);
