@@ -15,7 +15,7 @@
 # privately and include "util/io_util.h"; a library user never does. Tests may link it too.
 #
 # The links of every module are recorded (finecap_write_module_graph), and a test compares them with
-# the module graph the README draws.
+# the module graph docs/architecture.md draws.
 
 function(finecap_add_module name)
   cmake_parse_arguments(ARG "" "" "DEPENDS;LIBRARIES" ${ARGN})

@@ -18,7 +18,7 @@ rm -rf out/demo
 ./build/finecap refine --config configs/demo.yaml
 # Eval with its default settings (optical flow by DIS "medium" in all 4 cameras): 5.5 s for the
 # 5 frames of 512^2 against 4.5 s with eval.flow_dis_preset: fast (medians of 3, runs alternated);
-# the flow is cheap at this size, so the demo keeps the defaults whose figures the README quotes.
+# the flow is cheap at this size, so the demo keeps the defaults whose figures the README and docs/measurements.md quote.
 ./build/finecap eval --config configs/demo.yaml
 # The last frame: the folds are fully grown there (they ramp up from frame 0).
 normals="$(ls out/demo/eval/frame_*.png | tail -n 1)"

@@ -17,7 +17,7 @@ namespace {
 // How a length key that follows from the scene documents its default.
 std::string AutoText(double factor) {
   std::ostringstream text;
-  text << "auto: " << factor << " scene lengths (scene length: see the README).";
+  text << "auto: " << factor << " scene lengths (scene length: see docs/usage.md).";
   return text.str();
 }
 
@@ -94,7 +94,7 @@ std::vector<std::string> FlowChoices() {
 
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString("capture.dir", &config->capture.dir,
-                    "Capture folder (cameras, images or videos, meshes; see the README).");
+                    "Capture folder (cameras, images or videos, meshes; see docs/capture-format.md).");
   schema->AddString("capture.frames", &config->capture.frames,
                     "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
                     "\"\" = all.");

@@ -110,8 +110,8 @@ void CompareConfig::Check() const {
 void AddCompareKeys(CompareConfig* compare, ConfigSchema* schema) {
   schema->AddCustom(
       "compare.variants", "list of variants", "",
-      "finecap compare: the variants to run, each {name: NAME, set: {key: value, ...}}; see the "
-      "README.",
+      "finecap compare: the variants to run, each {name: NAME, set: {key: value, ...}}; see "
+      "docs/usage.md.",
       [compare](const YAML::Node& value, const std::string& where) {
         Require(value.IsSequence(), where,
                 "expected a list of variants such as [{name: a, set: {solver.type: lbfgs}}]");

@@ -51,7 +51,7 @@ int RunSynth(const Config& config);
 constexpr int kStatusIncomplete = 3;
 
 // Reports which of the configured frames (of shard runtime.shard) are done in output.dir, a
-// folder of `finecap refine` (mesh, displacement and stats record: see the README): prints
+// folder of `finecap refine` (mesh, displacement and stats record: see docs/usage.md): prints
 // "<folder>: D of T frames done (frames A:B)" and a "missing ..." line per run of consecutive
 // missing frames. Returns 0 when every frame is done, kStatusIncomplete otherwise; throws Error
 // naming output.dir when there is no such folder. Writes nothing.

@@ -21,7 +21,7 @@ namespace finecap {
 
 // Where the input comes from.
 struct CaptureConfig {
-  // Capture folder (layout in the README). Relative paths are relative to the working directory.
+  // Capture folder (layout: docs/capture-format.md); a relative path is from the working directory.
   std::string dir;
   // Frames to process, "A:B" = indices A to B-1 of the sorted frame list; "" = all frames.
   std::string frames;

@@ -4,7 +4,7 @@
 // allowed range or set of choices, and the field it writes. Reading a YAML file against the schema
 // refuses unknown keys, wrong types and out-of-range values with an Error naming the file and the
 // key path; an override ("key=value", from the command line) goes through the same checks. The
-// schema also prints itself, so `--help` and the README list every key with its default.
+// schema also prints itself, so `--help` and docs/configuration.md list every key with its default.
 #ifndef FINECAP_CONFIG_CONFIG_SCHEMA_H_
 #define FINECAP_CONFIG_CONFIG_SCHEMA_H_
 
@@ -61,7 +61,7 @@ class ConfigSchema {
                  std::function<std::string()> current_text);
 
   // A former name of key `path` (which must be registered), still read and set as `path` so
-  // that older configs keep working; help and the README list it as such.
+  // that older configs keep working; help and docs/configuration.md list it as such.
   void AddAlias(const std::string& old_path, const std::string& path);
 
   // Reads a YAML file into the bound fields. Keys absent from the file keep their values.
@@ -91,7 +91,7 @@ class ConfigSchema {
 
   // One line per key below `prefix` ("" for all): path, type, default, range, documentation.
   std::string HelpText(const std::string& prefix = "") const;
-  // A Markdown table of all keys, for the README.
+  // A Markdown table of all keys: docs/configuration.md (checked by tests/docs_test.cc).
   std::string MarkdownTable() const;
 
  private:

@@ -71,13 +71,13 @@ struct EnergyOptions {
   //  kSurfaceColor:  each surface Gaussian's colour against the image colour around its
   //                   projection, the overlap-weighted mean of the image Gaussians' colours (a
   //                   closed-form least-squares residual per surface Gaussian and camera; see
-  //                   the README for why it peaks at the true surface where the paper's does not);
+  //                   docs/method.md for why it peaks at the true surface, the paper's not);
   //  kConsensus:     the cameras that see a patch of surface Gaussians must agree on its
   //                   normalised colours; no reference colours (consensus_similarity.h).
   // Default kConsensus: on captures whose reference frame is as coarse as any other (every real
   // one) it recovers detail where surface_color, whose reference colours then belong to the
-  // wrong surface points, does not (measured with `finecap probe` and `finecap refine`, see the
-  // README; configs/surface_color.yaml keeps surface_color's settings).
+  // wrong surface points, does not (measured with `finecap probe` and `finecap refine`, see
+  // docs/method.md; configs/surface_color.yaml keeps surface_color's settings).
   SimilarityType similarity = SimilarityType::kConsensus;
   // Closed form of the overlap of two Gaussians: kPrinted (the paper's equation), kExact (the
   // true integral, half the exponent) or kPatch. See gaussian_overlap.h.

@@ -35,7 +35,7 @@ namespace finecap {
 // similarity counts it as disagreement; next to a projected surface Gaussian of 1.3-1.7 px (the
 // synthetic studio, sigma_hat at 3 m) it was the energy's noise floor wherever the input is
 // within a pixel of the truth (the samba dancer's smoothed input: -4.9 % with 2 px leaves,
-// +16 % with 1 px; the README's consensus table). configs/surface_color.yaml keeps 2 px.
+// +16 % with 1 px; docs/method.md's consensus table). configs/surface_color.yaml keeps 2 px.
 inline ImageGaussianOptions RefinementImageOptions() {
   ImageGaussianOptions options;
   options.min_leaf_size = 1;

@@ -64,12 +64,12 @@ struct SolverOptions {
   // Ceres only: the linear solver. Conjugate gradients by default: the normal equations are
   // diagonal but for the regulariser, so a few products solve them to the accuracy the step
   // needs, at a fifth of the time of SuiteSparse's factorisation on synth_skirt and to the same
-  // error on every capture measured (README, "Where a frame's time goes").
+  // error on every capture measured (docs/measurements.md, "Where a frame's time goes").
   LinearSolverType linear_solver = LinearSolverType::kCgnr;
   // Ceres only: the curvature of the similarity's model. Default secant: the consensus energy
   // curves less than J^T J says (Ceres' steps gained 1.2-1.6 times what the model predicted), and
-  // with the secant Ceres ends nearer the energy's optimum for the same evaluations (README,
-  // "Solvers").
+  // with the secant Ceres ends nearer the energy's optimum for the same evaluations
+  // (docs/method.md, "Solvers").
   CurvatureModel curvature = CurvatureModel::kSecant;
 
   // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
