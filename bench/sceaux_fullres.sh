@@ -11,8 +11,10 @@
 # SAMPLE is the OpenMVS sample (github.com/cdcseacave/openMVS_sample): a checkout whose
 # images/000NN.jpg are the photos, or a git directory of it without a work tree (the photos are
 # then read with `git show`). Nothing is written there or into the shared capture: the full-size
-# capture (the shared one's cameras with focal lengths x 4 and, pixel centres being integers,
-# c_full = 4 c + 1.5) is built in a temporary folder.
+# capture (bench/sceaux_full_resolution.sh: the shared one's cameras with focal lengths x 4 and,
+# pixel centres being integers, c_full = 4 c + 1.5) is built in a temporary folder, and refined
+# with the shared capture's held-out views left out (and scored at full size as well, which the
+# run's time includes).
 #
 # Prints one "name: value" a line: heldout_ncc_input and heldout_ncc_refined (the mean NCC of the
 # two held-out views), refine_seconds and refine_peak_mb (wall time and peak resident memory of
@@ -29,52 +31,20 @@ work=$(cd "$work" && pwd)
 rm -rf "$work/full" "$work/run" "$work/scored_input" "$work/scored_refined" "$work/score_"*
 [ -x build/finecap ] || bash scripts/build.sh >/dev/null
 
-# The photo of camera v000NN.
-photo() {
-  if [ -f "$sample/images/$1.jpg" ]; then
-    cat "$sample/images/$1.jpg"
-  else
-    git -C "$sample" show "HEAD:images/$1.jpg"
-  fi
-}
+# The sample's photos as files (from its git directory when it has no work tree), then the
+# full-size capture (bench/sceaux_full_resolution.sh).
+photos=$sample/images
+if [ ! -f "$photos/00000.jpg" ]; then
+  photos=$work/photos
+  mkdir -p "$photos"
+  for name in $(git -C "$sample" ls-tree --name-only HEAD images/ | grep '\.jpg$'); do
+    git -C "$sample" show "HEAD:$name" >"$photos/$(basename "$name")"
+  done
+fi
+SCEAUX=$capture bash bench/sceaux_full_resolution.sh "$photos" "$work/full" >/dev/null
 
-# The full-size capture: every camera that heldout.yaml does not hold out.
-mkdir -p "$work/full/meshes"
-cp "$capture/meshes/000000.ply" "$work/full/meshes/"
-python3 - "$capture" "$work/full/cameras.yaml" <<'PY' >"$work/full/training.txt"
-import re, sys
-capture, out = sys.argv[1], sys.argv[2]
-held_out = re.findall(r"v\d+", open(f"{capture}/heldout.yaml").read())
-cameras, current = [], None
-for line in open(f"{capture}/cameras.yaml"):
-    name = re.match(r"\s*- name:\s*(\S+)", line)
-    if name:
-        current = {"name": name.group(1)}
-        cameras.append(current)
-        continue
-    field = re.match(r"\s*(\w+):\s*(.+)", line)
-    if current is not None and field:
-        current[field.group(1)] = field.group(2).strip()
-with open(out, "w") as yaml:
-    yaml.write("cameras:\n")
-    for camera in cameras:
-        if camera["name"] in held_out:
-            continue
-        K = [float(v) for v in camera["K"].strip("[]").split(",")]
-        K[0] *= 4; K[4] *= 4; K[2] = 4 * K[2] + 1.5; K[5] = 4 * K[5] + 1.5
-        yaml.write(f"  - name: {camera['name']}\n    width: {4 * int(camera['width'])}\n")
-        yaml.write(f"    height: {4 * int(camera['height'])}\n")
-        yaml.write(f"    K: [{', '.join(repr(v) for v in K)}]\n")
-        yaml.write(f"    R: {camera['R']}\n    t: {camera['t']}\n")
-        print(camera["name"])
-PY
-while read -r name; do
-  mkdir -p "$work/full/images/$name"
-  photo "${name#v}" >"$work/full/images/$name/000000.jpg"
-done <"$work/full/training.txt"
-
-/usr/bin/time -f "%e %M" -o "$work/refine.time" build/finecap refine --capture "$work/full" \
-  --out "$work/run" --set "${SET:-}" >/dev/null 2>"$work/refine.log"
+/usr/bin/time -f "%e %M" -o "$work/refine.time" build/finecap refine --config "$capture/heldout.yaml" \
+  --capture "$work/full" --out "$work/run" --set "${SET:-}" >/dev/null 2>"$work/refine.log"
 
 # Each mesh as given, scored in the held-out views like the input of a capture with every camera.
 score() {
