@@ -96,6 +96,12 @@ std::vector<YAML::Node> SynthAndRefine(const std::string& name, const std::strin
   EXPECT_EQ(refine.exit_code, 0) << refine.output;
   std::vector<YAML::Node> records = ReadStats(root + "/run");
   EXPECT_EQ(records.size(), 3u) << refine.output;
+  // The figures, for re-measuring the bounds (ctest -V, or the test binary itself).
+  for (const YAML::Node& record : records) {
+    std::printf("%s frame %s: %.3f mm as given, %.3f mm refined\n", name.c_str(),
+                record["frame"].as<std::string>().c_str(), record["rms_coarse_mm"].as<double>(),
+                record["rms_refined_mm"].as<double>());
+  }
   return records;
 }
 
@@ -167,7 +173,11 @@ YAML::Node HeldOutRecord(const std::string& name, const std::string& capture,
   EXPECT_EQ(refine.exit_code, 0) << refine.output;
   const std::vector<YAML::Node> records = ReadStats(root + "/run");
   EXPECT_EQ(records.size(), 1u) << refine.output;
-  return records.empty() ? YAML::Node() : records[0];
+  if (records.empty()) return YAML::Node();
+  std::printf("%s held-out NCC: %.4f as given, %.4f refined\n", name.c_str(),
+              records[0]["heldout_ncc_input"].as<double>(),
+              records[0]["heldout_ncc_refined"].as<double>());
+  return records[0];
 }
 
 // The Middlebury temple (16 photos of 640 x 480, a visual hull as the input; configs/temple.yaml
@@ -247,6 +257,7 @@ TEST_P(QualityProbeTest, OptimumNoFurtherFromTheTruthThanToday) {
       RunFinecap("probe " + (probe.config.empty() ? "" : "--config " + Config(probe.config) + " ") +
                  "--capture " + root + "/capture --frame 0 --out " + root + "/probe");
   ASSERT_EQ(run.exit_code, 0) << run.output;
+  std::printf("%s", run.output.c_str());
   const double similarity = PrintedFigure(run.output, "similarity_alpha_optimum");
   EXPECT_LE(std::abs(similarity - 1.0), probe.similarity_distance + kProbeMargin) << similarity;
   if (probe.energy_distance >= 0.0) {
