@@ -82,17 +82,14 @@ std::vector<YAML::Node> ReadStats(const std::string& run) {
 }
 
 // The synthetic capture of `config` (frames 0-2 of it, at its full size: 8 cameras of 1004 x
-// 1004 take a few seconds a frame), refined with the defaults plus `settings`; its records.
-std::vector<YAML::Node> SynthAndRefine(const std::string& name, const std::string& config,
-                                       const std::string& settings = "") {
+// 1004 take a few seconds a frame), refined with the defaults; its records.
+std::vector<YAML::Node> SynthAndRefine(const std::string& name, const std::string& config) {
   const std::string root = testing_util::MakeTempDir("quality_" + name);
   const RunResult synth = RunFinecap("synth --config " + Config(config) + " --out " + root +
                                      "/capture --set " + kSynthFrames);
   EXPECT_EQ(synth.exit_code, 0) << synth.output;
-  std::string refine_args =
-      "refine --capture " + root + "/capture --out " + root + "/run --frames " + kFrames;
-  if (!settings.empty()) refine_args += " --set " + settings;
-  const RunResult refine = RunFinecap(refine_args);
+  const RunResult refine = RunFinecap("refine --capture " + root + "/capture --out " + root +
+                                      "/run --frames " + kFrames);
   EXPECT_EQ(refine.exit_code, 0) << refine.output;
   std::vector<YAML::Node> records = ReadStats(root + "/run");
   EXPECT_EQ(records.size(), 3u) << refine.output;
