@@ -10,7 +10,9 @@ PACKAGES=(
   libpng-dev libjpeg62-turbo-dev libdeflate-dev  # finecap's own PNG and JPEG codecs (util)
   libgflags-dev libgoogle-glog-dev libyaml-cpp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  gnuplot-nox clang-format libjs-three
+  gnuplot-nox clang-format
+  libjs-three  # the report's 3D view; a test opens it in chromium (scripts/check-report.sh)
+  chromium fonts-dejavu-core  # headless, for that test; without them it would skip
   clang-14 libclang-rt-14-dev
   colmap  # a test reads the text model COLMAP writes itself; 4 MB download, 16 MB installed
 )
