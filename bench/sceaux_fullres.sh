@@ -37,8 +37,9 @@ photos=$sample/images
 if [ ! -f "$photos/00000.jpg" ]; then
   photos=$work/photos
   mkdir -p "$photos"
-  for name in $(git -C "$sample" ls-tree --name-only HEAD images/ | grep '\.jpg$'); do
-    git -C "$sample" show "HEAD:$name" >"$photos/$(basename "$name")"
+  for camera in "$capture"/images/v000*; do  # The photos of the shared capture's cameras.
+    name=000${camera: -2}.jpg
+    git -C "$sample" show "HEAD:images/$name" >"$photos/$name"
   done
 fi
 SCEAUX=$capture bash bench/sceaux_full_resolution.sh "$photos" "$work/full" >/dev/null
