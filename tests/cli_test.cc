@@ -1,37 +1,20 @@
 // The command line as a user meets it: subcommands listed, bad input refused with one message
 // naming the file and the problem, a non-zero exit, and no output written.
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "run_finecap.h"
 #include "test_util.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together.
-};
-
-RunResult RunFinecap(const std::string& arguments, const std::string& prefix = "") {
-  RunResult result;
-  const std::string command = prefix + std::string(FINECAP_BINARY) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using finecap::testing_util::RunFinecap;
+using finecap::testing_util::RunResult;
 
 // The same, run from `working` with `environment` ("NAME=value ...") set.
 RunResult RunFinecapIn(const fs::path& working, const std::string& environment,

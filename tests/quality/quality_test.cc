@@ -8,10 +8,8 @@
 // few times the run-to-run spread of its figure (thread scheduling changes the order of sums,
 // and the held-out score's pixels change with the surfaces), and well below what a regression
 // such as a 100 times stronger regulariser or the plane sweep switched off costs.
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -25,6 +23,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include "run_finecap.h"
 #include "test_util.h"
 
 namespace finecap {
@@ -37,23 +36,8 @@ namespace fs = std::filesystem;
 constexpr char kFrames[] = "0:3";
 constexpr char kSynthFrames[] = "synth.num_frames=3";
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together.
-};
-
-// Runs the finecap binary with `arguments`; its output is returned (and shown on failure).
-RunResult RunFinecap(const std::string& arguments) {
-  RunResult result;
-  const std::string command = std::string(FINECAP_BINARY) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer;
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using testing_util::RunFinecap;
+using testing_util::RunResult;
 
 std::string Config(const std::string& name) {
   return std::string(FINECAP_SOURCE_DIR) + "/configs/" + name;
