@@ -120,8 +120,7 @@ TEST(Docs, RelativeLinksResolve) {
         const fs::path resolved = file.empty() ? page : page.parent_path() / file;
         ++checked;
         if (!fs::exists(resolved)) {
-          ADD_FAILURE() << name << ":" << number << ": the link " << target
-                        << " points to no file";
+          ADD_FAILURE() << name << ":" << number << ": the link " << target << " points to no file";
           continue;
         }
         if (!anchor.empty() && resolved.extension() == ".md") {

@@ -93,8 +93,9 @@ std::vector<std::string> FlowChoices() {
 }
 
 void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
-  schema->AddString("capture.dir", &config->capture.dir,
-                    "Capture folder (cameras, images or videos, meshes; see docs/capture-format.md).");
+  schema->AddString(
+      "capture.dir", &config->capture.dir,
+      "Capture folder (cameras, images or videos, meshes; see docs/capture-format.md).");
   schema->AddString("capture.frames", &config->capture.frames,
                     "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
                     "\"\" = all.");

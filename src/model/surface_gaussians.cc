@@ -107,7 +107,7 @@ void WriteReferenceColors(const std::string& path, const ReferenceColors& colors
   std::ostringstream text;
   text
       << "# finecap reference colours: one line per mesh vertex, 'valid c0 c1 c2' with the colour\n"
-      << "# embedded in the colour space below (see docs/method.md); valid = 0 where no camera saw\n"
+      << "# embedded in the colour space below (docs/method.md); valid = 0 where no camera saw\n"
       << "# the vertex in the reference frame.\n"
       << "color_space " << ColorSpaceName(colors.color_space) << "\n"
       << std::setprecision(9) << "sigma_hat " << colors.sigma_hat << "\n"
