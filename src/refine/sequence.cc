@@ -488,8 +488,6 @@ RefineOptions ReferencePassOptions(const RefineOptions& configured, const Captur
   pass.subdivision_levels = configured.subdivision_levels;
   pass.subdivision = configured.subdivision;
   pass.energy.reg_rings = configured.energy.reg_rings;
-  pass.energy.consensus.patch_rings =
-      std::min(pass.energy.consensus.patch_rings, pass.energy.reg_rings);
   pass.solver.num_threads = configured.solver.num_threads;
   ResolveSceneScaleDefaults(capture, reference_frame, &pass);
   return pass;

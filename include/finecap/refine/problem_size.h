@@ -48,7 +48,8 @@ struct ProblemSize {
   // Forecast peak resident memory of a run refining frames like this one, MB.
   double peak_memory_mb = 0.0;
   // Forecast time of one frame, seconds, on the machine the constants were measured on (2 cores);
-  // a rough figure, good to a factor of about 3.
+  // a rough figure, within 0.5 to 2 times the CPU time over two cores on the captures that
+  // bench/memory_forecast.sh covers.
   double seconds_per_frame = 0.0;
 };
 
