@@ -1,6 +1,7 @@
 #include "finecap/refine/frame_stats.h"
 
 #include <cmath>
+#include <memory>
 
 #include <gtest/gtest.h>
 
@@ -49,6 +50,8 @@ FrameStats SampleStats() {
   stats.heldout_mad_input = 12.5;
   stats.heldout_mad_subdivided = 13.0;
   stats.heldout_mad_refined = 11.0;
+  stats.peak_rss_mb = 35.25;
+  stats.heap_in_use_mb = 6.5;
   stats.skipped_cameras = {"cam 1", "tab\there", "caf\xC3\xA9"};
   return stats;
 }
@@ -90,7 +93,9 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
                                     &FrameStats::heldout_ncc_refined,
                                     &FrameStats::heldout_mad_input,
                                     &FrameStats::heldout_mad_subdivided,
-                                    &FrameStats::heldout_mad_refined}) {
+                                    &FrameStats::heldout_mad_refined,
+                                    &FrameStats::peak_rss_mb,
+                                    &FrameStats::heap_in_use_mb}) {
     ExpectSameReal(stats.*field, back.*field);
   }
   EXPECT_EQ(back.iterations, 17);
@@ -104,6 +109,24 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
   EXPECT_EQ(back.skipped_cameras, stats.skipped_cameras);
   // Written again, the record is the same text.
   EXPECT_EQ(ToJson(back), ToJson(stats));
+}
+
+// A live block counts while it is held and no longer once it is freed.
+TEST(HeapInUseMegabytesTest, CountsLiveBlocks) {
+  const double before = HeapInUseMegabytes();
+  auto block = std::make_unique<char[]>(8 << 20);
+  block[0] = 1;
+  const double holding = HeapInUseMegabytes();
+  block.reset();
+  const double after = HeapInUseMegabytes();
+#if defined(__SANITIZE_ADDRESS__)
+  // The sanitizer's allocator is not glibc's, whose statistics stay as they were.
+  EXPECT_EQ(holding, before);
+  EXPECT_EQ(after, before);
+#else
+  EXPECT_GE(holding - before, 8.0);
+  EXPECT_LT(after, holding - 7.9);
+#endif
 }
 
 TEST(FrameStatsParse, WritesTheSkippedCamerasAsAList) {

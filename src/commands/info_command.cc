@@ -73,8 +73,10 @@ int RunInfo(const Config& configured) {
   const int first = frames.size() > 0 ? frames.begin : config.reference_frame;
   FrameInput input = ReadFrameInput(&capture, first);
   const std::vector<CalibratedImage> held_out = TakeHeldOutViews(config.validation.cameras, &input);
-  const ProblemSize size = EstimateProblemSize(
-      model, colors, input, config.refine, std::max(frames.size(), 1), UndistortedPixels(capture));
+  ProblemSize size = EstimateProblemSize(model, colors, input, config.refine,
+                                         std::max(frames.size(), 1), UndistortedPixels(capture));
+  AddHeldOutScoring(held_out, static_cast<int>(input.cameras.size()),
+                    config.validation.score.neighbours, &size);
 
   std::cout << "capture: " << capture.directory() << "\n";
   PrintCameras(capture, input.cameras, held_out, size);

@@ -174,6 +174,40 @@ cv::Mat NccMap(const HeldOutWindows& windows, const cv::Mat& warped_grey, const 
   return ncc;
 }
 
+// Rows of the held-out view whose NCC is computed at once. The window statistics are images of
+// doubles, and over a whole full-size photo (2832 x 2128: 48 MB each) every one of the dozens a
+// pair makes would exceed the largest block the heap holds (heap.h), be mapped on its own and
+// faulted in page by page; a band of 128 rows (and the window's half above and below it) keeps
+// them in the heap and in the caches, and lets the bands run in parallel.
+constexpr int kBandRows = 128;
+
+// NccMap of every warped image of `warps`, band by band. A band's statistics are those of the
+// whole view at its rows (the window never reaches beyond the rows read for it) up to the
+// rounding of the box filter's running sums.
+std::vector<cv::Mat> NccMaps(const cv::Mat& grey, const std::vector<Warp>& warps,
+                             const cv::Mat& common, const HeldOutOptions& options) {
+  std::vector<cv::Mat> maps;
+  for (size_t s = 0; s < warps.size(); ++s) {
+    maps.emplace_back(common.size(), CV_32F, cv::Scalar(kNaN));
+  }
+  const int rows = common.rows, halo = options.window / 2;
+  const int num_bands = (rows + kBandRows - 1) / kBandRows;
+#pragma omp parallel for schedule(dynamic)
+  for (int band = 0; band < num_bands; ++band) {
+    const int begin = band * kBandRows, end = std::min(rows, begin + kBandRows);
+    const cv::Range read(std::max(0, begin - halo), std::min(rows, end + halo));
+    const cv::Range kept(begin - read.start, end - read.start);
+    const cv::Mat band_common = common.rowRange(read);
+    const HeldOutWindows windows = MakeHeldOutWindows(grey.rowRange(read), band_common, options);
+    for (size_t s = 0; s < warps.size(); ++s) {
+      NccMap(windows, warps[s].grey.rowRange(read), band_common, options.window)
+          .rowRange(kept)
+          .copyTo(maps[s].rowRange(begin, end));
+    }
+  }
+  return maps;
+}
+
 // 255 where a CV_32F map is finite (OpenCV's comparisons do not single out NaN).
 cv::Mat FiniteMask(const cv::Mat& values) {
   cv::Mat mask(values.size(), CV_8U);
@@ -298,11 +332,10 @@ PairScore ScorePair(const HeldOutTarget& target, const CalibratedImage& training
                                        options, with_color));
     common &= warps.back().valid;
   }
-  const HeldOutWindows windows = MakeHeldOutWindows(target.grey, common, options);
   PairScore pair;
+  pair.ncc_maps = NccMaps(target.grey, warps, common, options);
   for (int s = 0; s < num_surfaces; ++s) {
-    pair.ncc_maps.push_back(NccMap(windows, warps[s].grey, common, options.window));
-    const auto [ncc, ncc_pixels] = FiniteMean(pair.ncc_maps.back());
+    const auto [ncc, ncc_pixels] = FiniteMean(pair.ncc_maps[s]);
     const double mad =
         MeanAbsoluteDifference(target.grey, warps[s].grey, common, &pair.common_pixels);
     pair.surfaces.push_back({ncc, mad});

@@ -1,5 +1,6 @@
 #include "finecap/refine/frame_stats.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 
 #include <cmath>
@@ -21,6 +22,11 @@ double PeakResidentMegabytes() {
   rusage usage = {};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes.
+}
+
+double HeapInUseMegabytes() {
+  const struct mallinfo2 heap = mallinfo2();
+  return static_cast<double>(heap.uordblks + heap.hblkhd) / (1 << 20);
 }
 
 double ProcessCpuSeconds() {
@@ -59,6 +65,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.rms_textureless_coarse_mm = stats.rms_textureless_subdivided_mm =
       stats.rms_textureless_refined_mm = std::nan("");
   stats.peak_rss_mb = PeakResidentMegabytes();
+  stats.heap_in_use_mb = HeapInUseMegabytes();
   return stats;
 }
 
@@ -97,7 +104,8 @@ std::string ToJson(const FrameStats& s) {
        << ", \"heldout_mad_input\": " << JsonNumber(s.heldout_mad_input)
        << ", \"heldout_mad_subdivided\": " << JsonNumber(s.heldout_mad_subdivided)
        << ", \"heldout_mad_refined\": " << JsonNumber(s.heldout_mad_refined)
-       << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb) << ", \"skipped_cameras\": [";
+       << ", \"peak_rss_mb\": " << JsonNumber(s.peak_rss_mb)
+       << ", \"heap_in_use_mb\": " << JsonNumber(s.heap_in_use_mb) << ", \"skipped_cameras\": [";
   for (size_t c = 0; c < s.skipped_cameras.size(); ++c) {
     json << (c > 0 ? ", " : "") << JsonString(s.skipped_cameras[c]);
   }
@@ -141,7 +149,8 @@ struct StatsFields {
       {"heldout_mad_input", &FrameStats::heldout_mad_input},
       {"heldout_mad_subdivided", &FrameStats::heldout_mad_subdivided},
       {"heldout_mad_refined", &FrameStats::heldout_mad_refined},
-      {"peak_rss_mb", &FrameStats::peak_rss_mb}};
+      {"peak_rss_mb", &FrameStats::peak_rss_mb},
+      {"heap_in_use_mb", &FrameStats::heap_in_use_mb}};
   std::vector<std::pair<const char*, int FrameStats::*>> ints = {
       {"iterations", &FrameStats::iterations},
       {"evaluations", &FrameStats::evaluations},

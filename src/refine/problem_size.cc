@@ -94,6 +94,11 @@ constexpr double kBytesPerSurfaceSample = 205.0;
 constexpr double kSecondsPerPairWithSamples = 0.355e-6;
 constexpr double kSecondsPerSampleRead = 0.116e-6;
 
+// The held-out score, per pixel of a held-out view and training view warped into it (for the
+// three surfaces refine scores): fitted to Sceaux's two held-out views, at the capture's 708 x 532
+// and at full resolution (2832 x 2128), on 2 idle cores.
+constexpr double kSecondsPerHeldOutPixelPair = 0.2e-6;
+
 // The samples of a regular vertex's patch of `rings` rings after `levels` of linear subdivision:
 // the hexagon of radius rings * 2^levels without its rim.
 int SamplesPerRegularPatch(int rings, int levels) {
@@ -180,6 +185,17 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
           << size.samples_per_patch << " samples a patch; per frame " << per_frame / 1e6
           << " MB, detail " << detail_bytes / 1e6 << " MB, " << (cholesky ? "Cholesky" : "CGNR");
   return size;
+}
+
+void AddHeldOutScoring(const std::vector<CalibratedImage>& held_out, int num_training,
+                       int neighbours, ProblemSize* size) {
+  double pixel_pairs = 0.0;
+  for (const CalibratedImage& view : held_out) {
+    pixel_pairs +=
+        double(view.camera.width) * view.camera.height * std::min(neighbours, num_training);
+  }
+  size->seconds_held_out = pixel_pairs * kSecondsPerHeldOutPixelPair;
+  size->seconds_per_frame += size->seconds_held_out;
 }
 
 void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,

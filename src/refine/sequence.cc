@@ -210,9 +210,10 @@ class SequenceRun {
   // refused here.
   void ReportProblemSize(const FrameRange& frames) {
     FrameReadAhead::Frame first = reader_.Take(frames.begin);
-    const ProblemSize size =
-        EstimateProblemSize(model_, reference_colors_, first.input, options_.refine, frames.size(),
-                            UndistortedPixels(*capture_));
+    ProblemSize size = EstimateProblemSize(model_, reference_colors_, first.input, options_.refine,
+                                           frames.size(), UndistortedPixels(*capture_));
+    AddHeldOutScoring(first.held_out, static_cast<int>(first.input.cameras.size()),
+                      options_.held_out_score.neighbours, &size);
     RequireMemoryFor(size, frames.size(), options_.refine, options_.max_memory_mb,
                      ReadAvailableMemory());
     observer_->Starting(frames.size(), first.input, size);

@@ -72,10 +72,19 @@ struct FrameStats {
   // The process's peak resident memory when the frame was done (getrusage's ru_maxrss), MB of
   // 2^20 bytes. Over a long run it should stay flat: nothing grows with the frames.
   double peak_rss_mb = 0.0;
+  // The bytes the heap holds in live blocks when the frame was done (glibc's mallinfo2: uordblks
+  // and hblkhd), MB of 2^20 bytes; 0 where another allocator replaces glibc's (the sanitizers).
+  // Where peak_rss_mb also counts pages that were touched once and kept (the heap is not given
+  // back, and is backed by 2 MB pages: heap.h), this is what a leak would make grow. Frames
+  // prepared ahead on other threads make it vary by a few MB from frame to frame.
+  double heap_in_use_mb = 0.0;
 };
 
 // The peak resident memory of this process so far, MB of 2^20 bytes (getrusage's ru_maxrss).
 double PeakResidentMegabytes();
+
+// The heap's live blocks now, MB of 2^20 bytes (see FrameStats::heap_in_use_mb).
+double HeapInUseMegabytes();
 
 // The CPU time this process has used so far, every thread, user and system, seconds.
 double ProcessCpuSeconds();

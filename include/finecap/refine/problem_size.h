@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "finecap/io/capture.h"
+#include "finecap/measure/heldout_score.h"
 #include "finecap/refine/refine.h"
 #include "finecap/util/memory.h"
 
@@ -47,10 +48,12 @@ struct ProblemSize {
 
   // Forecast peak resident memory of a run refining frames like this one, MB.
   double peak_memory_mb = 0.0;
-  // Forecast time of one frame, seconds, on the machine the constants were measured on (2 cores);
-  // a rough figure, within 0.5 to 2 times the CPU time over two cores on the captures that
-  // bench/memory_forecast.sh covers.
+  // Forecast time of one frame, seconds, on the machine the constants were measured on (2 idle
+  // cores), the held-out score included once AddHeldOutScoring has added it: a rough figure,
+  // within 0.5 to 2 times the wall time on the captures that bench/memory_forecast.sh covers.
   double seconds_per_frame = 0.0;
+  // Of which the held-out score (AddHeldOutScoring; 0 without held-out views).
+  double seconds_held_out = 0.0;
 };
 
 // The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
@@ -63,6 +66,12 @@ struct ProblemSize {
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
                                 const FrameInput& frame, const RefineOptions& options,
                                 int num_frames = 1, double undistorted_pixels = 0.0);
+
+// Adds to `size` the time of scoring each frame in the `held_out` views (ScoreHeldOutViews of
+// three surfaces, each warping in the `neighbours` nearest of `num_training` training views):
+// at full resolution it is a large part of a frame.
+void AddHeldOutScoring(const std::vector<CalibratedImage>& held_out, int num_training,
+                       int neighbours, ProblemSize* size);
 
 // The pixels of `capture`'s cameras that have lens distortion, every one, held out or not: their
 // images are undistorted as they are read.
