@@ -99,9 +99,13 @@ FrameStats Record(double energy_end, double rms_coarse, double rms_refined, doub
 }
 
 TEST(ComparisonTest, SummaryMatchesAHandComputation) {
-  const std::vector<FrameStats> frames = {Record(-3.0, 6.0, 3.0, 1.0), Record(-1.0, 8.0, 4.0, 5.0),
-                                          Record(-2.0, 0.0, 0.0, 2.0)};
+  std::vector<FrameStats> frames = {Record(-3.0, 6.0, 3.0, 1.0), Record(-1.0, 8.0, 4.0, 5.0),
+                                    Record(-2.0, 0.0, 0.0, 2.0)};
+  // The first frame has no flicker: the others' are pooled.
+  frames[1].flicker_refined_mm = 1.0;
+  frames[2].flicker_refined_mm = 7.0;
   const VariantSummary row = SummarizeVariant("v", frames, {-10.0, -20.0, -30.0});
+  EXPECT_DOUBLE_EQ(row.flicker_textured_mm, 5.0);
   EXPECT_EQ(row.frames, 3);
   EXPECT_DOUBLE_EQ(row.energy_end, -2.0);
   EXPECT_DOUBLE_EQ(row.ls_cost_end, 2.0);

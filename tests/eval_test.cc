@@ -198,7 +198,19 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
     EXPECT_NEAR(figures["rms_subdivided_mm"].as<double>(), stats["rms_subdivided_mm"].as<double>(),
                 1e-6);
     EXPECT_NEAR(figures["rms_refined_mm"].as<double>(), stats["rms_refined_mm"].as<double>(), 1e-6);
+    // And the flicker since the frame before, which the first frame lacks.
+    for (const char* flicker :
+         {"flicker_coarse_mm", "flicker_subdivided_mm", "flicker_refined_mm"}) {
+      if (i == 0) {
+        EXPECT_TRUE(figures[flicker].IsNull()) << flicker;
+        EXPECT_TRUE(stats[flicker].IsNull()) << flicker;
+        continue;
+      }
+      EXPECT_GT(figures[flicker].as<double>(), 0.0) << flicker;
+      EXPECT_NEAR(figures[flicker].as<double>(), stats[flicker].as<double>(), 1e-6) << flicker;
+    }
   }
+  EXPECT_TRUE(std::isfinite(metrics["flicker_refined_mm"].as<double>()));
   for (const std::string frame : {"000000", "000001", "000002"}) {
     // Every picture is cut to the same box around the subject, inside the 96 x 96 view.
     const cv::Mat error = cv::imread(out + "/eval/error_" + frame + ".png");
@@ -211,6 +223,7 @@ TEST(EvalCommandTest, WritesMetricsPicturesPlotsAndReport) {
   }
   EXPECT_TRUE(IsPngOfSize(out + "/eval/rms.png", 800, 500));
   EXPECT_TRUE(IsPngOfSize(out + "/eval/normal_error.png", 800, 500));
+  EXPECT_TRUE(IsPngOfSize(out + "/eval/flicker.png", 800, 500));
   EXPECT_TRUE(IsPngOfSize(out + "/eval/flow.png", 800, 500));
   const std::string csv = FileBytes(out + "/eval/flow.csv");
   EXPECT_EQ(csv.rfind("frame,flow_coarse_px,flow_refined_px,flow_improvement_percent\n000000,", 0),

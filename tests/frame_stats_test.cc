@@ -44,6 +44,9 @@ FrameStats SampleStats() {
   stats.rms_textureless_coarse_mm = 0.0;
   stats.rms_textureless_subdivided_mm = 1.5;
   stats.rms_textureless_refined_mm = -3.25;
+  stats.flicker_coarse_mm = 0.875;
+  stats.flicker_subdivided_mm = 0.75;
+  stats.flicker_refined_mm = std::nan("");
   stats.heldout_ncc_input = 0.5;
   stats.heldout_ncc_subdivided = 0.25;
   stats.heldout_ncc_refined = 0.75;
@@ -88,6 +91,9 @@ TEST(FrameStatsParse, RoundTripsEveryField) {
                                     &FrameStats::rms_textureless_coarse_mm,
                                     &FrameStats::rms_textureless_subdivided_mm,
                                     &FrameStats::rms_textureless_refined_mm,
+                                    &FrameStats::flicker_coarse_mm,
+                                    &FrameStats::flicker_subdivided_mm,
+                                    &FrameStats::flicker_refined_mm,
                                     &FrameStats::heldout_ncc_input,
                                     &FrameStats::heldout_ncc_subdivided,
                                     &FrameStats::heldout_ncc_refined,
@@ -145,6 +151,7 @@ TEST(FrameStatsParse, ReadsJsonEscapesAndOlderRecords) {
   EXPECT_EQ(stats.iterations, 4);
   EXPECT_TRUE(stats.skipped_cameras.empty());
   EXPECT_EQ(stats.solver, "");
+  EXPECT_TRUE(std::isnan(stats.flicker_refined_mm));  // Not measured, rather than none.
 }
 
 TEST(FrameStatsParse, RefusesMalformedRecordsNamingTheProblem) {

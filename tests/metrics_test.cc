@@ -141,5 +141,55 @@ TEST(MetricsAngularError, NoUsablePairGivesNaNAndSizeMismatchThrows) {
       {"normal sets", "different sizes"});
 }
 
+// A steady error, however large, does not flicker; one that swaps sign every frame, +e then -e,
+// changes by 2e.
+TEST(MetricsFlicker, IsTheRmsChangeOfTheSignedErrorFromOneFrameToTheNext) {
+  const std::vector<int> all = {0, 1, 2};
+  const Eigen::VectorXd offset = Vector({0.3, 0.3, 0.3});
+  EXPECT_EQ(ComputeFlicker(offset, offset, all).rms, 0.0);
+  EXPECT_EQ(ComputeFlicker(offset, offset, all).count, 3);
+  const double e = 0.25;
+  EXPECT_DOUBLE_EQ(ComputeFlicker(Vector({e, -e, e}), Vector({-e, e, -e}), all).rms, 2 * e);
+  // Changes 0, 3 and 4: RMS sqrt(25 / 3); a vertex unknown in either frame does not count.
+  EXPECT_DOUBLE_EQ(ComputeFlicker(Vector({1, 1, -2}), Vector({1, 4, 2}), all).rms,
+                   std::sqrt(25.0 / 3.0));
+  const ErrorStats partial = ComputeFlicker(Vector({kNaN, 1, -2}), Vector({1, 4, kNaN}), all);
+  EXPECT_EQ(partial.count, 1);
+  EXPECT_DOUBLE_EQ(partial.rms, 3.0);
+  EXPECT_TRUE(ComputeFlicker(Vector({kNaN}), Vector({1}), {0}).empty());
+}
+
+TEST(MetricsFlicker, SignedErrorsAreKnownWhereTheRefinementGaveAValue) {
+  const SignedErrors errors =
+      SignedErrorsOf(Vector({0.5, kNaN, 0.0}), Vector({0.25, 1.0, kNaN}), Vector({2, 3, 4}));
+  EXPECT_DOUBLE_EQ(errors.refined[0], 0.25);
+  EXPECT_TRUE(std::isnan(errors.refined[1]) && std::isnan(errors.refined[2]));
+  EXPECT_DOUBLE_EQ(errors.subdivided[0], -0.25);
+  EXPECT_TRUE(std::isnan(errors.subdivided[1]));  // Not refined.
+  EXPECT_DOUBLE_EQ(errors.coarse[0], -2.0);
+  EXPECT_TRUE(std::isnan(errors.coarse[1]));
+  EXPECT_DOUBLE_EQ(errors.coarse[2], -4.0);
+  ExpectErrorMentions(
+      [] {
+        SignedErrorsOf(Vector({0}), Vector({0, 0}), Vector({0}));
+      },
+      {"different sizes"});
+}
+
+// Each surface against its own error in the frame before; no frame before, no flicker.
+TEST(MetricsFlicker, OfEachSurfaceAgainstTheFrameBefore) {
+  const std::vector<int> all = {0, 1};
+  // The truth moves by 1 and 3 mm; the refinement follows it to within a steady 0.5 mm.
+  const SignedErrors before = SignedErrorsOf(Vector({0.5, 0.5}), Vector({0, 0}), Vector({0, 0}));
+  const SignedErrors now = SignedErrorsOf(Vector({1.5, 3.5}), Vector({1, 3}), Vector({1, 3}));
+  const FlickerStats flicker = ComputeFlickers(before, now, all);
+  EXPECT_DOUBLE_EQ(flicker.refined.rms, 0.0);
+  EXPECT_DOUBLE_EQ(flicker.subdivided.rms, std::sqrt(5.0));
+  EXPECT_DOUBLE_EQ(flicker.coarse.rms, std::sqrt(5.0));
+  const FlickerStats none = ComputeFlickers(SignedErrors{}, now, all);
+  EXPECT_TRUE(none.refined.empty() && none.subdivided.empty() && none.coarse.empty());
+  EXPECT_TRUE(std::isnan(none.refined.rms));
+}
+
 }  // namespace
 }  // namespace finecap

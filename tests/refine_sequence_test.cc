@@ -125,6 +125,12 @@ class CountingObserver : public SequenceObserver {
   std::vector<std::string> refined;
 };
 
+// A tiny refinable capture of `frames` frames, generated in `root`/capture, opened.
+Capture OpenTinyCapture(const std::string& root, int frames) {
+  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(frames), root + "/capture");
+  return Capture::Open(root + "/capture");
+}
+
 SequenceOptions QuickOptions() {
   SequenceOptions options;
   options.refine.solver.max_iterations = 2;
@@ -172,14 +178,48 @@ TEST(RefineSequenceTest, RefinesTheFramesLeftAndReportsThem) {
   ExpectErrorMentions([&] { RefineSequence(&capture, {0, 2}, options, out); }, {"sigma_hat"});
 }
 
+// Each frame's flicker is measured against the frame before it: none for the first frame, and
+// the same whether the frame before was refined by the same call or read back from the run
+// folder (a resumed run, the next shard).
+TEST(RefineSequenceTest, FlickerFollowsTheFrameBeforeAcrossResumesAndShards) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_flicker");
+  Capture capture = OpenTinyCapture(root, 3);
+  const SequenceOptions options = QuickOptions();
+  const std::string whole = root + "/whole", parts = root + "/parts";
+  const SequenceResult result = RefineSequence(&capture, {0, 3}, options, whole);
+  EXPECT_TRUE(std::isnan(Record(whole, "000000").flicker_refined_mm));
+  EXPECT_TRUE(std::isnan(Record(whole, "000000").flicker_subdivided_mm));
+  double sum2 = 0.0;
+  for (const std::string frame : {"000001", "000002"}) {
+    const FrameStats record = Record(whole, frame);
+    EXPECT_GT(record.flicker_refined_mm, 0.0) << frame;
+    EXPECT_GT(record.flicker_subdivided_mm, 0.0) << frame;  // The folds drift.
+    EXPECT_GT(record.flicker_coarse_mm, 0.0) << frame;
+    sum2 += record.flicker_refined_mm * record.flicker_refined_mm;
+  }
+  EXPECT_EQ(result.flickered, 2);
+  EXPECT_NEAR(result.flicker_refined_mm, std::sqrt(sum2 / 2), 1e-6);
+
+  // Frame 0, then frame 1 resumed, then frame 2 as a shard of its own.
+  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
+    RefineSequence(&capture, part, options, parts);
+  }
+  for (const std::string frame : {"000001", "000002"}) {
+    const FrameStats expected = Record(whole, frame), actual = Record(parts, frame);
+    EXPECT_NEAR(actual.flicker_refined_mm, expected.flicker_refined_mm, 1e-9) << frame;
+    EXPECT_NEAR(actual.flicker_subdivided_mm, expected.flicker_subdivided_mm, 1e-9) << frame;
+    EXPECT_NEAR(actual.flicker_coarse_mm, expected.flicker_coarse_mm, 1e-9) << frame;
+  }
+}
+
 // The reference colours are saved with what they were made of; a run that would make them
 // otherwise (here: another quad-tree depth, which the file's own fields do not show) is refused,
 // while a file saved before recipes were still resumes.
 TEST(RefineSequenceTest, ReferenceColoursOfAnotherRecipeAreRefused) {
   const OneWorkerThread one_thread;
   const std::string root = MakeTempDir("sequence_recipe");
-  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), root + "/capture");
-  Capture capture = Capture::Open(root + "/capture");
+  Capture capture = OpenTinyCapture(root, 2);
   const SequenceOptions options = QuickOptions();
   const std::string out = root + "/run";
   fs::create_directories(out);

@@ -21,6 +21,7 @@
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
 #include "finecap/io/mesh_io.h"
+#include "finecap/refine/frame_stats.h"
 #include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
@@ -127,7 +128,14 @@ void ExpectNoPartialFile(const std::string& out) {
   }
 }
 
-// `out` holds the very frames of `reference`, with displacements within 1e-9 m and the same
+// The flicker figures of `frame`'s record in `out`, NaN where it has none.
+std::vector<double> Flicker(const std::string& out, int frame) {
+  const FrameStats record = ReadFrameStats(out + "/frames/" + FrameName(frame) + ".json");
+  return {record.flicker_coarse_mm, record.flicker_subdivided_mm, record.flicker_refined_mm};
+}
+
+// `out` holds the very frames of `reference`, with displacements within 1e-9 m, the same flicker
+// within 1e-6 mm (measured against the frame before, wherever that frame was refined) and the same
 // records in stats.jsonl, in frame order.
 void ExpectSameResults(const std::string& reference, const std::string& out) {
   for (const char* folder : {"meshes", "k", "frames"}) {
@@ -145,6 +153,13 @@ void ExpectSameResults(const std::string& reference, const std::string& out) {
       } else {
         EXPECT_NEAR(actual[v], expected[v], 1e-9) << file << " vertex " << v;
       }
+    }
+    const std::vector<double> expected_flicker = Flicker(reference, frame),
+                              actual_flicker = Flicker(out, frame);
+    for (size_t i = 0; i < expected_flicker.size(); ++i) {
+      // No frame before the first; every other frame follows a done one.
+      EXPECT_EQ(std::isnan(expected_flicker[i]), frame == 0) << FrameName(frame);
+      if (frame > 0) EXPECT_NEAR(actual_flicker[i], expected_flicker[i], 1e-6) << FrameName(frame);
     }
   }
   std::istringstream lines(FileBytes(out + "/stats.jsonl"));

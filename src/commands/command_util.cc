@@ -194,6 +194,10 @@ class ConsoleObserver : public SequenceObserver {
       detail << ", RMS vs truth " << stats.rms_coarse_mm << " (subdivided "
              << stats.rms_subdivided_mm << ") -> " << stats.rms_refined_mm << " mm";
     }
+    if (std::isfinite(stats.flicker_refined_mm)) {
+      detail << ", flicker " << stats.flicker_subdivided_mm << " -> " << stats.flicker_refined_mm
+             << " mm";
+    }
     progress_.FrameDone(stats.frame, false, detail.str());
   }
 
@@ -235,6 +239,13 @@ void RefineConfiguredSequence(const Config& config, const FrameRange& frames,
               << result.rms_subdivided_mm << " mm), refined " << result.rms_refined_mm
               << " mm, detail recovered "
               << 100.0 * (1.0 - result.rms_refined_mm / result.rms_coarse_mm) << " %\n";
+  }
+  if (result.flickered > 0) {
+    std::cout << "Flicker (RMS change of the signed error from one frame to the next, over the "
+              << result.flickered << " frames run now that follow a done frame): input as given "
+              << result.flicker_coarse_mm << " mm (subdivided " << result.flicker_subdivided_mm
+              << " mm), refined " << result.flicker_refined_mm << " mm, "
+              << result.flicker_refined_mm / result.rms_refined_mm << " of the refined error\n";
   }
 }
 

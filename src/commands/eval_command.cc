@@ -59,6 +59,13 @@ void PrintFigures(const RunEvaluation& evaluation) {
               << " (subdivided " << all.normal_error_subdivided_deg << ") -> "
               << all.normal_error_refined_deg << " degrees\n";
   }
+  if (std::isfinite(all.flicker.refined.rms)) {
+    std::cout << "Flicker (RMS change of the signed error from one frame to the next): input as "
+              << "given " << 1000.0 * all.flicker.coarse.rms << " mm (subdivided "
+              << 1000.0 * all.flicker.subdivided.rms << " mm), refined "
+              << 1000.0 * all.flicker.refined.rms << " mm, "
+              << all.flicker.refined.rms / all.refined.rms << " of the refined error\n";
+  }
   if (!evaluation.heldout.empty()) {
     // The input as given, its subdivision, the refined mesh.
     const std::vector<SurfaceScore>& pooled = evaluation.heldout;

@@ -25,6 +25,15 @@ double RootMeanSquare(const std::vector<double>& values) {
   return std::sqrt(sum / values.size());
 }
 
+// Over the finite values only: NaN when there is none.
+double RootMeanSquareOfFinite(const std::vector<double>& values) {
+  std::vector<double> finite;
+  for (double value : values) {
+    if (std::isfinite(value)) finite.push_back(value);
+  }
+  return RootMeanSquare(finite);
+}
+
 // One number of every record, as double.
 template <typename Number>
 std::vector<double> Column(const std::vector<FrameStats>& frames, Number FrameStats::*field) {
@@ -55,6 +64,7 @@ const std::vector<NumberColumn>& NumberColumns() {
       {"rms_input_mm", "RMS input mm", &V::rms_input_mm, 1.0},
       {"rms_textured_mm", "RMS textured mm", &V::rms_textured_mm, 1.0},
       {"rms_textureless_mm", "RMS textureless mm", &V::rms_textureless_mm, 1.0},
+      {"flicker_textured_mm", "flicker textured mm", &V::flicker_textured_mm, 1.0},
       {"detail_recovered_percent", "detail recovered %", &V::detail_recovered, 100.0},
       {"iterations", "iterations", &V::iterations, 1.0},
       {"evaluations", "evaluations", &V::evaluations, 1.0},
@@ -89,6 +99,7 @@ VariantSummary SummarizeVariant(const std::string& name, const std::vector<Frame
   row.rms_input_mm = RootMeanSquare(Column(frames, &FrameStats::rms_coarse_mm));
   row.rms_textured_mm = RootMeanSquare(Column(frames, &FrameStats::rms_refined_mm));
   row.rms_textureless_mm = RootMeanSquare(Column(frames, &FrameStats::rms_textureless_refined_mm));
+  row.flicker_textured_mm = RootMeanSquareOfFinite(Column(frames, &FrameStats::flicker_refined_mm));
   row.detail_recovered = DetailRecovered(row.rms_textured_mm, row.rms_input_mm);
   row.iterations = Mean(Column(frames, &FrameStats::iterations));
   row.evaluations = Mean(Column(frames, &FrameStats::evaluations));

@@ -45,6 +45,7 @@ RegionFigures RegionFiguresOf(const EvaluationSamples& samples, const std::vecto
   figures.subdivided = ComputeErrorStats(zero, samples.k_true, region);
   figures.refined = ComputeErrorStats(samples.k_refined, samples.k_true, region);
   figures.detail_recovered = DetailRecovered(figures.refined.rms, figures.coarse.rms);
+  figures.flicker = ComputeFlickers(samples.errors_before, samples.Errors(), region);
   const std::vector<int> measured = Measured(samples, region);
   const Eigen::Matrix3Xd truth = Columns(samples.normals_true, measured);
   const auto normal_error = [&](const Eigen::Matrix3Xd& normals) {
@@ -68,6 +69,21 @@ Eigen::VectorXd OneAfterTheOther(const Eigen::VectorXd& first, const Eigen::Vect
   return joined;
 }
 
+// `errors` when it has `size` entries, else `size` unknowns: a frame without the frame before.
+Eigen::VectorXd OrUnknown(const Eigen::VectorXd& errors, Eigen::Index size) {
+  return errors.size() == size ? errors : Eigen::VectorXd::Constant(size, ErrorStats::kNoData);
+}
+
+// The errors before of `first` and then `second`, the unknown ones NaN.
+SignedErrors ErrorsBeforeOfBoth(const EvaluationSamples& first, const EvaluationSamples& second) {
+  const auto join = [&](Eigen::VectorXd SignedErrors::*surface) {
+    return OneAfterTheOther(OrUnknown(first.errors_before.*surface, first.k_refined.size()),
+                            OrUnknown(second.errors_before.*surface, second.k_refined.size()));
+  };
+  return {join(&SignedErrors::coarse), join(&SignedErrors::subdivided),
+          join(&SignedErrors::refined)};
+}
+
 void AppendOffset(const std::vector<int>& ids, int offset, std::vector<int>* into) {
   for (int id : ids) into->push_back(id + offset);
 }
@@ -76,6 +92,7 @@ void AppendOffset(const std::vector<int>& ids, int offset, std::vector<int>* int
 
 void EvaluationSamples::Append(const EvaluationSamples& other) {
   const int offset = static_cast<int>(k_refined.size());
+  errors_before = ErrorsBeforeOfBoth(*this, other);
   AppendOffset(other.all, offset, &all);
   AppendOffset(other.textured, offset, &textured);
   AppendOffset(other.textureless, offset, &textureless);
@@ -86,6 +103,10 @@ void EvaluationSamples::Append(const EvaluationSamples& other) {
   normals_input = SideBySide(normals_input, other.normals_input);
   normals_refined = SideBySide(normals_refined, other.normals_refined);
   normals_true = SideBySide(normals_true, other.normals_true);
+}
+
+SignedErrors EvaluationSamples::Errors() const {
+  return SignedErrorsOf(k_refined, k_true, coarse_error);
 }
 
 EvaluationSamples MakeEvaluationSamples(const Mesh& coarse, const Mesh& input, const Mesh& refined,

@@ -181,6 +181,10 @@ struct EvaluationRun {
   std::vector<internal::HeldOutFrame> heldout;  // Per frame; empty without validation.cameras.
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
+  // The signed errors of the frame evaluated last, which the frame after it (index
+  // `next_index`) measures its flicker against.
+  int next_index = -1;
+  SignedErrors errors_before_next;
 };
 
 void EvaluateFrame(const RefinedFrame& frame, const RunEvaluationOptions& options,
@@ -195,9 +199,12 @@ void EvaluateFrame(const RefinedFrame& frame, const RunEvaluationOptions& option
   if (truth.empty()) {
     truth.k_true = truth.coarse_error = Eigen::VectorXd::Constant(k.size(), ErrorStats::kNoData);
   }
-  const EvaluationSamples samples = MakeEvaluationSamples(
+  EvaluationSamples samples = MakeEvaluationSamples(
       model.Interpolate(coarse), input, refined, k, truth.k_true, truth.coarse_error,
       model.refined_vertices(), textureless, frame.files.mesh);
+  if (frame.index == run->next_index) samples.errors_before = run->errors_before_next;
+  run->next_index = frame.index + 1;
+  run->errors_before_next = samples.Errors();
   const EvaluationFigures figures = ComputeEvaluationFigures(samples);
   run->names.push_back(frame.name);
   run->frame_indices.push_back(frame.index);
@@ -253,6 +260,9 @@ std::string RegionJson(const RegionFigures& region) {
        << ", \"p95_abs_subdivided_mm\": " << JsonNumber(Millimetres(region.subdivided.p95_abs))
        << ", \"p95_abs_refined_mm\": " << JsonNumber(Millimetres(region.refined.p95_abs))
        << ", \"detail_recovered\": " << JsonNumber(region.detail_recovered)
+       << ", \"flicker_coarse_mm\": " << JsonNumber(Millimetres(region.flicker.coarse.rms))
+       << ", \"flicker_subdivided_mm\": " << JsonNumber(Millimetres(region.flicker.subdivided.rms))
+       << ", \"flicker_refined_mm\": " << JsonNumber(Millimetres(region.flicker.refined.rms))
        << ", \"normal_error_coarse_deg\": " << JsonNumber(region.normal_error_coarse_deg)
        << ", \"normal_error_subdivided_deg\": " << JsonNumber(region.normal_error_subdivided_deg)
        << ", \"normal_error_refined_deg\": " << JsonNumber(region.normal_error_refined_deg) << "}";
@@ -284,6 +294,9 @@ std::string MetricsJson(const EvaluationRun& run, const EvaluationFigures& seque
        << ",\n  \"rms_subdivided_mm\": " << JsonNumber(Millimetres(all.subdivided.rms))
        << ",\n  \"rms_refined_mm\": " << JsonNumber(Millimetres(all.refined.rms))
        << ",\n  \"detail_recovered\": " << JsonNumber(all.detail_recovered)
+       << ",\n  \"flicker_coarse_mm\": " << JsonNumber(Millimetres(all.flicker.coarse.rms))
+       << ",\n  \"flicker_subdivided_mm\": " << JsonNumber(Millimetres(all.flicker.subdivided.rms))
+       << ",\n  \"flicker_refined_mm\": " << JsonNumber(Millimetres(all.flicker.refined.rms))
        << ",\n  \"normal_error_coarse_deg\": " << JsonNumber(all.normal_error_coarse_deg)
        << ",\n  \"normal_error_subdivided_deg\": " << JsonNumber(all.normal_error_subdivided_deg)
        << ",\n  \"normal_error_refined_deg\": " << JsonNumber(all.normal_error_refined_deg)
@@ -338,7 +351,32 @@ std::vector<std::pair<std::string, std::string>> WriteFlowPlot(const EvaluationR
   return {{path, "Optical flow over the frames (the paper's Figure 6)"}};
 }
 
-// The two plots over the frames, when there is ground truth to plot; returns their paths.
+// The flicker of each surface and the refined error over the frames at `path`, when some frame
+// has a flicker figure; whether it did.
+bool WriteFlickerPlot(const EvaluationRun& run, const std::string& path) {
+  const std::vector<PlotSeries> flicker = {
+      SeriesOverFrames(
+          "flicker input", run,
+          [](const EvaluationFigures& f) { return Millimetres(f.all.flicker.coarse.rms); }),
+      SeriesOverFrames(
+          "flicker subdivided", run,
+          [](const EvaluationFigures& f) { return Millimetres(f.all.flicker.subdivided.rms); }),
+      SeriesOverFrames(
+          "flicker refined", run,
+          [](const EvaluationFigures& f) { return Millimetres(f.all.flicker.refined.rms); }),
+      SeriesOverFrames("error refined", run,
+                       [](const EvaluationFigures& f) { return Millimetres(f.all.refined.rms); })};
+  if (!AnyFinite(flicker[2])) return false;
+  PlotOptions options;
+  options.x_label = "frame";
+  options.title = "RMS change of the signed error since the frame before, and the refined error";
+  options.y_label = "mm";
+  WriteLinePlot(path, flicker, options);
+  return true;
+}
+
+// The plots over the frames (error, normal error, flicker), when there is ground truth to plot;
+// returns their paths.
 std::vector<std::pair<std::string, std::string>> WritePlots(const EvaluationRun& run,
                                                             const std::string& eval_dir) {
   const std::vector<PlotSeries> rms = {
@@ -366,8 +404,13 @@ std::vector<std::pair<std::string, std::string>> WritePlots(const EvaluationRun&
   options.title = "Mean angle between vertex normals and the true normals";
   options.y_label = "degrees";
   WriteLinePlot(eval_dir + "/normal_error.png", normals, options);
-  return {{eval_dir + "/rms.png", "Displacement error over the frames"},
-          {eval_dir + "/normal_error.png", "Normal error over the frames"}};
+  std::vector<std::pair<std::string, std::string>> plots = {
+      {eval_dir + "/rms.png", "Displacement error over the frames"},
+      {eval_dir + "/normal_error.png", "Normal error over the frames"}};
+  if (WriteFlickerPlot(run, eval_dir + "/flicker.png")) {
+    plots.push_back({eval_dir + "/flicker.png", "Flicker over the frames, beside the error"});
+  }
+  return plots;
 }
 
 std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& region) {
@@ -376,6 +419,9 @@ std::vector<TableCell> TableRow(const std::string& name, const RegionFigures& re
           Millimetres(region.coarse.rms),
           Millimetres(region.subdivided.rms),
           Millimetres(region.refined.rms),
+          Millimetres(region.flicker.coarse.rms),
+          Millimetres(region.flicker.subdivided.rms),
+          Millimetres(region.flicker.refined.rms),
           Millimetres(region.coarse.mean_abs),
           Millimetres(region.refined.mean_abs),
           Millimetres(region.coarse.p95_abs),
@@ -461,6 +507,9 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                                            "RMS input mm",
                                            "RMS subdivided mm",
                                            "RMS refined mm",
+                                           "flicker input mm",
+                                           "flicker subdivided mm",
+                                           "flicker refined mm",
                                            "mean input mm",
                                            "mean refined mm",
                                            "p95 input mm",
@@ -476,8 +525,11 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
       "refined vertices, of the input as given (the coarse mesh's triangles sampled at the fine "
       "vertices), of its Loop subdivision (where refinement starts, k of 0) and of the refined "
       "mesh (k - k_true). Detail recovered: 1 - RMS refined / RMS input, against the input as "
-      "given. True normals: the subdivided input mesh displaced by the true k. n/a: no ground "
-      "truth or an empty region.");
+      "given. Flicker: the RMS of the change of the signed error (refined minus true) from the "
+      "frame before, over the vertices known in both frames, what shows as shimmer when the "
+      "sequence is played; a steady error has none. True normals: the subdivided input mesh "
+      "displaced by the true k. n/a: no ground truth, an empty region or, for the flicker, no "
+      "frame before.");
   report.AddTable(header,
                   {TableRow("all", sequence.all), TableRow("textured", sequence.textured),
                    TableRow("textureless", sequence.textureless)},

@@ -90,6 +90,29 @@ ErrorStats ComputeErrorStats(const Eigen::VectorXd& estimate, const Eigen::Vecto
   return StatsOfAbsoluteErrors(std::move(absolute_errors));
 }
 
+SignedErrors SignedErrorsOf(const Eigen::VectorXd& k, const Eigen::VectorXd& k_true,
+                            const Eigen::VectorXd& coarse_error) {
+  RequireSameSize(k.size(), k_true.size(), "displacement and true displacement");
+  RequireSameSize(k.size(), coarse_error.size(), "displacement and coarse error");
+  const auto where_refined = [&](const Eigen::VectorXd& error) -> Eigen::VectorXd {
+    return k.array().isFinite().select(error, kNaN);
+  };
+  return {where_refined(-coarse_error), where_refined(-k_true), k - k_true};
+}
+
+ErrorStats ComputeFlicker(const Eigen::VectorXd& before, const Eigen::VectorXd& now,
+                          const std::vector<int>& indices) {
+  return ComputeErrorStats(now, before, indices);
+}
+
+FlickerStats ComputeFlickers(const SignedErrors& before, const SignedErrors& now,
+                             const std::vector<int>& indices) {
+  if (before.empty() || now.empty()) return {};
+  return {ComputeFlicker(before.coarse, now.coarse, indices),
+          ComputeFlicker(before.subdivided, now.subdivided, indices),
+          ComputeFlicker(before.refined, now.refined, indices)};
+}
+
 double DetailRecovered(double rms_refined, double rms_coarse) {
   if (!std::isfinite(rms_coarse) || rms_coarse <= 0.0) return kNaN;
   return 1.0 - rms_refined / rms_coarse;

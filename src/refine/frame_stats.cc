@@ -95,6 +95,9 @@ std::string ToJson(const FrameStats& s) {
        << ", \"rms_coarse_mm\": " << JsonNumber(s.rms_coarse_mm)
        << ", \"rms_subdivided_mm\": " << JsonNumber(s.rms_subdivided_mm)
        << ", \"rms_refined_mm\": " << JsonNumber(s.rms_refined_mm)
+       << ", \"flicker_coarse_mm\": " << JsonNumber(s.flicker_coarse_mm)
+       << ", \"flicker_subdivided_mm\": " << JsonNumber(s.flicker_subdivided_mm)
+       << ", \"flicker_refined_mm\": " << JsonNumber(s.flicker_refined_mm)
        << ", \"rms_textureless_coarse_mm\": " << JsonNumber(s.rms_textureless_coarse_mm)
        << ", \"rms_textureless_subdivided_mm\": " << JsonNumber(s.rms_textureless_subdivided_mm)
        << ", \"rms_textureless_refined_mm\": " << JsonNumber(s.rms_textureless_refined_mm)
@@ -140,6 +143,9 @@ struct StatsFields {
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_subdivided_mm", &FrameStats::rms_subdivided_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},
+      {"flicker_coarse_mm", &FrameStats::flicker_coarse_mm},
+      {"flicker_subdivided_mm", &FrameStats::flicker_subdivided_mm},
+      {"flicker_refined_mm", &FrameStats::flicker_refined_mm},
       {"rms_textureless_coarse_mm", &FrameStats::rms_textureless_coarse_mm},
       {"rms_textureless_subdivided_mm", &FrameStats::rms_textureless_subdivided_mm},
       {"rms_textureless_refined_mm", &FrameStats::rms_textureless_refined_mm},

@@ -130,6 +130,27 @@ void AddGroundTruthErrors(const FineGroundTruth& truth, const Regions& regions,
   stats->rms_textureless_refined_mm = rms_mm(result.k, truth.k_true, regions.textureless);
 }
 
+// The flicker of the three surfaces between `before` and `now` (a frame's SignedErrors and the
+// frame before's; empty: unknown) over the textured region, into `stats`.
+void AddFlicker(const SignedErrors& before, const SignedErrors& now, const Regions& regions,
+                FrameStats* stats) {
+  const FlickerStats flicker = ComputeFlickers(before, now, regions.textured);
+  stats->flicker_coarse_mm = 1000.0 * flicker.coarse.rms;
+  stats->flicker_subdivided_mm = 1000.0 * flicker.subdivided.rms;
+  stats->flicker_refined_mm = 1000.0 * flicker.refined.rms;
+}
+
+// A frame's signed errors against its truth (empty: no truth), and which frame they are of.
+struct FrameErrors {
+  int frame = -1;
+  SignedErrors errors;
+};
+
+SignedErrors SignedErrorsAgainst(const FineGroundTruth& truth, const Eigen::VectorXd& k) {
+  if (truth.empty()) return {};
+  return SignedErrorsOf(k, truth.k_true, truth.coarse_error);
+}
+
 // The held-out score of the frame's coarse mesh as given, of its subdivision and of its result
 // (as solved), into `stats`; a result whose held-out NCC is below the input's as given is
 // flagged worse and, with keep_input_if_worse, replaced by the subdivided input.
@@ -185,6 +206,39 @@ void WriteFrame(const FrameFiles& files, const FrameResult& result, MeshFormat f
   log.Append(record);
 }
 
+// The root mean square over frames of a figure of the three surfaces (the input as given, its
+// subdivision, the result), each frame's own RMS squared and summed.
+class RmsOverFrames {
+ public:
+  void Add(double coarse, double subdivided, double refined) {
+    coarse2_ += coarse * coarse;
+    subdivided2_ += subdivided * subdivided;
+    refined2_ += refined * refined;
+    ++frames_;
+  }
+  int frames() const { return frames_; }
+  double coarse() const { return std::sqrt(coarse2_ / frames_); }
+  double subdivided() const { return std::sqrt(subdivided2_ / frames_); }
+  double refined() const { return std::sqrt(refined2_ / frames_); }
+
+ private:
+  double coarse2_ = 0.0, subdivided2_ = 0.0, refined2_ = 0.0;
+  int frames_ = 0;
+};
+
+// The run's error and flicker figures, from those of its frames.
+void SetRunFigures(const RmsOverFrames& errors, const RmsOverFrames& flicker,
+                   SequenceResult* result) {
+  result->measured = errors.frames();
+  result->rms_coarse_mm = errors.coarse();
+  result->rms_subdivided_mm = errors.subdivided();
+  result->rms_refined_mm = errors.refined();
+  result->flickered = flicker.frames();
+  result->flicker_coarse_mm = flicker.coarse();
+  result->flicker_subdivided_mm = flicker.subdivided();
+  result->flicker_refined_mm = flicker.refined();
+}
+
 // One run over the frames: what stays fixed while they are refined.
 class SequenceRun {
  public:
@@ -224,7 +278,7 @@ class SequenceRun {
     if (!FollowsColors(options_)) RequireNoFollowedColors();
     SaveColors();
     prepare_ahead_ = !FollowsColors(options_);
-    double sum_coarse2 = 0.0, sum_subdivided2 = 0.0, sum_refined2 = 0.0;
+    RmsOverFrames errors, flicker;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
       if (Done(frame)) {
         observer_->FrameAlreadyDone(capture_->frame_name(frame));
@@ -234,16 +288,14 @@ class SequenceRun {
       const FrameStats stats = RefineOne(frame, frames);
       ++result->refined;
       if (std::isfinite(stats.rms_refined_mm)) {
-        sum_coarse2 += stats.rms_coarse_mm * stats.rms_coarse_mm;
-        sum_subdivided2 += stats.rms_subdivided_mm * stats.rms_subdivided_mm;
-        sum_refined2 += stats.rms_refined_mm * stats.rms_refined_mm;
-        ++result->measured;
+        errors.Add(stats.rms_coarse_mm, stats.rms_subdivided_mm, stats.rms_refined_mm);
+      }
+      if (std::isfinite(stats.flicker_refined_mm)) {
+        flicker.Add(stats.flicker_coarse_mm, stats.flicker_subdivided_mm, stats.flicker_refined_mm);
       }
       observer_->FrameRefined(stats);
     }
-    result->rms_coarse_mm = std::sqrt(sum_coarse2 / result->measured);
-    result->rms_subdivided_mm = std::sqrt(sum_subdivided2 / result->measured);
-    result->rms_refined_mm = std::sqrt(sum_refined2 / result->measured);
+    SetRunFigures(errors, flicker, result);
   }
 
  private:
@@ -393,13 +445,32 @@ class SequenceRun {
     for (const SkippedCamera& camera : skipped) stats.skipped_cameras.push_back(camera.camera);
     ScoreInHeldOutViews(options_, model_, input, held_out, &result, &stats);
     AddGroundTruthErrors(read.truth, regions_, result, &stats);
+    FrameErrors errors{frame, SignedErrorsAgainst(read.truth, result.k)};
+    if (!errors.errors.empty()) AddFlicker(ErrorsBefore(frame), errors.errors, regions_, &stats);
     // Before the record, which marks the frame done: a done frame always has them.
     if (FollowsColors(options_) && frame >= options_.reference_frame) {
       SaveFollowedColors(name, colors, input, result, stats.worse);
     }
     WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
                start, cpu_seconds_at_start, log_);
+    last_errors_ = std::move(errors);
     return stats;
+  }
+
+  // The signed errors of the frame before `frame`: those this run just measured, else from that
+  // frame's saved displacement and its truth, which give the very same numbers (the displacement
+  // file reads back to the same doubles), so that a resumed run or a shard measures its first
+  // frame's flicker as a run that never stopped does. Empty when that frame is not done here or
+  // has no truth.
+  SignedErrors ErrorsBefore(int frame) const {
+    if (frame == 0) return {};
+    if (last_errors_.frame == frame - 1) return last_errors_.errors;
+    const FrameFiles files =
+        FrameFilesIn(out_, capture_->frame_name(frame - 1), options_.mesh_format);
+    if (!FrameDone(files) || !capture_->HasTrueSurface(frame - 1)) return {};
+    const Eigen::VectorXd k = ReadDisplacement(files.displacement, model_.num_fine_vertices());
+    return SignedErrorsAgainst(
+        TrueFineGroundTruth(*capture_, model_, capture_->ReadCoarseMesh(frame - 1), frame - 1), k);
   }
 
   Capture* capture_;
@@ -423,6 +494,8 @@ class SequenceRun {
   const Regions regions_;
   // The solver's problem, taken over by each frame from the one before (SolverWorkspace).
   SolverWorkspace solver_workspace_;
+  // The signed errors of the frame this run refined last, for the flicker of the next.
+  FrameErrors last_errors_;
 };
 
 }  // namespace

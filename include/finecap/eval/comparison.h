@@ -19,16 +19,17 @@ struct VariantSummary {
   std::string solver;      // solver.type.
   std::string similarity;  // energy.similarity: which energy `energy_end` is.
   int frames = 0;
-  double energy_end = 0.0;          // E of the variant's own energy at its result.
-  double paper_similarity = 0.0;    // The paper's E_sim at the result; NaN when not measured.
-  double ls_cost_end = 0.0;         // 1/2 sum of squared residuals of the least-squares form.
-  double rms_input_mm = 0.0;        // Textured region, the input mesh as given; NaN without truth.
-  double rms_textured_mm = 0.0;     // Textured region, the result.
-  double rms_textureless_mm = 0.0;  // Textureless region, the result; NaN when there is none.
-  double detail_recovered = 0.0;    // 1 - rms_textured_mm / rms_input_mm (metrics.h).
-  double iterations = 0.0;          // Mean per frame.
-  double evaluations = 0.0;         // Mean per frame.
-  double seconds_per_frame = 0.0;   // The whole frame: reading, preparation, solve, writing.
+  double energy_end = 0.0;           // E of the variant's own energy at its result.
+  double paper_similarity = 0.0;     // The paper's E_sim at the result; NaN when not measured.
+  double ls_cost_end = 0.0;          // 1/2 sum of squared residuals of the least-squares form.
+  double rms_input_mm = 0.0;         // Textured region, the input mesh as given; NaN without truth.
+  double rms_textured_mm = 0.0;      // Textured region, the result.
+  double rms_textureless_mm = 0.0;   // Textureless region, the result; NaN when there is none.
+  double flicker_textured_mm = 0.0;  // Over the frames with one (FrameStats); NaN: none has.
+  double detail_recovered = 0.0;     // 1 - rms_textured_mm / rms_input_mm (metrics.h).
+  double iterations = 0.0;           // Mean per frame.
+  double evaluations = 0.0;          // Mean per frame.
+  double seconds_per_frame = 0.0;    // The whole frame: reading, preparation, solve, writing.
   double seconds_solve = 0.0;
   double seconds_evaluation = 0.0;     // Of the solve.
   double seconds_linear_solver = 0.0;  // Of the solve; Ceres only.

@@ -8,6 +8,7 @@
 //   * the subdivided input mesh (k = 0), where the refinement starts: Loop's smoothing may bring
 //     it nearer the truth than the input as given or take it farther away.
 //   * the refined mesh.
+// Beside each error, its flicker (metrics.h): how much of it changes from one frame to the next.
 // Errors are taken over the refined vertices where the estimate and the truth are known. The true
 // normal of a vertex is the normal of the subdivided input mesh displaced by the true k (NaN
 // counted as 0): the true surface sampled at the vertex's own line, so no ray-cast triangle lookup
@@ -40,6 +41,12 @@ struct EvaluationSamples {
   std::vector<int> all;              // Refined vertex ids: the region every figure is taken over.
   std::vector<int> textured;         // The part of `all` outside the textureless region.
   std::vector<int> textureless;      // The part of `all` inside it.
+  // The signed errors of the frame before, one entry per vertex, NaN where unknown; empty when
+  // the frame before is not evaluated. The flicker figures compare Errors() with them.
+  SignedErrors errors_before;
+
+  // The samples' own signed errors: SignedErrorsOf(k_refined, k_true, coarse_error).
+  SignedErrors Errors() const;
 
   // Appends `other`, offsetting its vertex ids: pooled samples give sequence-wide figures.
   void Append(const EvaluationSamples& other);
@@ -58,6 +65,9 @@ struct RegionFigures {
   // DetailRecovered(refined.rms, coarse.rms), against the input as given: 1 perfect, 0 no gain,
   // < 0 worse.
   double detail_recovered = ErrorStats::kNoData;
+  // The flicker of each surface (ComputeFlickers): the change of its signed error since the frame
+  // before, over the region's vertices known in both frames; NaN without the frame before.
+  FlickerStats flicker;
 };
 
 // Figures over all refined vertices and over their textured and textureless parts.

@@ -41,6 +41,43 @@ ErrorStats ComputeErrorStats(const Eigen::VectorXd& estimate, const Eigen::Vecto
 ErrorStats ComputeErrorStats(const Eigen::VectorXd& estimate, const Eigen::VectorXd& truth,
                              const std::vector<int>& indices);
 
+// A frame's signed errors along the normals of its subdivided input mesh, one entry per fine
+// vertex, in the unit of the displacements (metres), NaN where unknown: of the coarse mesh as
+// given, of its subdivision (k = 0) and of the refined mesh (k - k_true).
+struct SignedErrors {
+  Eigen::VectorXd coarse;
+  Eigen::VectorXd subdivided;
+  Eigen::VectorXd refined;
+
+  bool empty() const { return refined.size() == 0; }
+};
+
+// The signed errors of a frame whose refined displacement is `k`, whose true displacement is
+// `k_true` and whose coarse mesh as given lies `coarse_error` from the truth along the same
+// normals (FineGroundTruth). All three are NaN where `k` is: the baselines are measured over the
+// vertices the refinement gave a value, as every error figure is. Throws Error when the sizes
+// differ.
+SignedErrors SignedErrorsOf(const Eigen::VectorXd& k, const Eigen::VectorXd& k_true,
+                            const Eigen::VectorXd& coarse_error);
+
+// The flicker of a surface from one frame to the next: ErrorStats of the change of its signed
+// error per vertex, `now - before` (two frames of one topology), over the entries of `indices`
+// where both are finite; its rms is the flicker figure. A steady error, however large, has none:
+// it is the part of the error that moves from frame to frame, which shows as shimmer when the
+// sequence is played. Throws Error as ComputeErrorStats does.
+ErrorStats ComputeFlicker(const Eigen::VectorXd& before, const Eigen::VectorXd& now,
+                          const std::vector<int>& indices);
+
+// The flicker of each of the three surfaces between two frames' SignedErrors. An empty `before`
+// (the frame before has no errors: not refined, or no truth) gives empty stats (NaN).
+struct FlickerStats {
+  ErrorStats coarse;
+  ErrorStats subdivided;
+  ErrorStats refined;
+};
+FlickerStats ComputeFlickers(const SignedErrors& before, const SignedErrors& now,
+                             const std::vector<int>& indices);
+
 // The share of the coarse input's error that refinement removed: 1 - rms_refined / rms_coarse.
 // 1 is a perfect recovery, 0 no gain, negative a refinement that made things worse. NaN when
 // rms_coarse is not a positive finite number (there was no detail to recover).

@@ -51,6 +51,14 @@ struct FrameStats {
   double rms_coarse_mm = 0.0;
   double rms_subdivided_mm = 0.0;
   double rms_refined_mm = 0.0;
+  // The flicker of the same three surfaces, millimetres: the RMS over the same vertices of the
+  // change of their signed error (ComputeFlicker, metrics.h) since the frame before, over the
+  // vertices with a truth and a refined k in both frames. NaN when the frame before has no errors
+  // here: the first frame, a frame without truth, or one whose predecessor was not done in the
+  // run folder when it was refined (a shard's first frame while the shard before still runs).
+  double flicker_coarse_mm = std::numeric_limits<double>::quiet_NaN();
+  double flicker_subdivided_mm = std::numeric_limits<double>::quiet_NaN();
+  double flicker_refined_mm = std::numeric_limits<double>::quiet_NaN();
   // The same over the textureless region (NaN when the capture marks none).
   double rms_textureless_coarse_mm = 0.0;
   double rms_textureless_subdivided_mm = 0.0;

@@ -187,6 +187,12 @@ struct SequenceResult {
   double rms_coarse_mm = 0.0;
   double rms_subdivided_mm = 0.0;
   double rms_refined_mm = 0.0;
+  // Over the frames refined now that have a flicker figure (`flickered` of them): the root mean
+  // square of their flicker_*_mm (FrameStats); NaN when none.
+  int flickered = 0;
+  double flicker_coarse_mm = 0.0;
+  double flicker_subdivided_mm = 0.0;
+  double flicker_refined_mm = 0.0;
 };
 
 // Refines frames [frames.begin, frames.end) of `capture` into the run folder `out` (created with
