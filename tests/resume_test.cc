@@ -159,7 +159,9 @@ void ExpectSameResults(const std::string& reference, const std::string& out) {
     for (size_t i = 0; i < expected_flicker.size(); ++i) {
       // No frame before the first; every other frame follows a done one.
       EXPECT_EQ(std::isnan(expected_flicker[i]), frame == 0) << FrameName(frame);
-      if (frame > 0) EXPECT_NEAR(actual_flicker[i], expected_flicker[i], 1e-6) << FrameName(frame);
+      if (frame > 0) {
+        EXPECT_NEAR(actual_flicker[i], expected_flicker[i], 1e-6) << FrameName(frame);
+      }
     }
   }
   std::istringstream lines(FileBytes(out + "/stats.jsonl"));
