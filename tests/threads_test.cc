@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "finecap/util/error.h"
+#include "finecap/util/process.h"
 
 namespace finecap {
 namespace {

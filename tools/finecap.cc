@@ -16,7 +16,7 @@
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
 #include "finecap/util/error.h"
-#include "finecap/util/heap.h"
+#include "finecap/util/process.h"
 #include "finecap/util/threads.h"
 
 DECLARE_bool(help);
@@ -33,6 +33,11 @@ DEFINE_string(shard, "",
               "$SLURM_ARRAY_TASK_ID/4; overrides runtime.shard.");
 DEFINE_bool(config_keys_markdown, false, "Print every config key as a Markdown table and exit.");
 DEFINE_int32(frame, -1, "probe: the frame (index) to probe; -1 = the last.");
+DEFINE_bool(one_malloc_arena, true,
+            "One malloc arena for every thread (lower peak memory; finecap/util/process.h).");
+DEFINE_int32(huge_page_heap_mb, 1024,
+             "Address space reserved at the heap's end on transparent huge pages, MB (fewer page "
+             "faults); 0: glibc's defaults (finecap/util/process.h).");
 DEFINE_string(set, "",
               "Overrides of any config keys, comma separated: "
               "--set output.mesh_format=obj,runtime.threads=2");
@@ -138,6 +143,8 @@ void PrintMainHelp() {
        {"config", "capture", "out", "frames", "shard", "solver", "frame", "threads", "set"}) {
     text += FlagHelp(flag);
   }
+  text += "\nProcess settings (finecap/util/process.h; the defaults are what measured best):\n";
+  for (const char* flag : {"one_malloc_arena", "huge_page_heap_mb"}) text += FlagHelp(flag);
   text += "\nConfig keys (YAML sections and keys; type, default, meaning):\n" + ConfigKeysHelp();
   text += "\n`finecap <subcommand> --help` describes one subcommand.\n";
   std::cout << text;
@@ -192,11 +199,22 @@ int Main(int argc, char** argv) {
   gflags::SetVersionString(FINECAP_VERSION);
   gflags::SetUsageMessage("finecap <subcommand> [--config FILE] [flags]; see finecap --help");
   gflags::ParseCommandLineNonHelpFlags(&argc, &argv, /*remove_flags=*/true);
+  // Before any thread starts (none has: flag parsing starts none).
+  const ProcessOptions process{.one_malloc_arena = FLAGS_one_malloc_arena,
+                               .huge_page_heap_mb = FLAGS_huge_page_heap_mb};
+  try {
+    process.Check();
+  } catch (const Error& error) {
+    throw Error("--huge_page_heap_mb", error.problem());  // Its only option with a range.
+  }
+  const bool huge_pages = ApplyProcessOptions(process);
   FLAGS_logtostderr = true;
   google::InitGoogleLogging(argv[0]);
   VLOG(1) << (SleepingWorkersSetByFinecap()
                   ? "OpenMP's workers sleep between loops (OMP_WAIT_POLICY=passive)"
-                  : "OpenMP's wait policy is the environment's");
+                  : "OpenMP's wait policy is the environment's")
+          << "; " << (FLAGS_one_malloc_arena ? "one malloc arena" : "glibc's malloc arenas") << "; "
+          << (huge_pages ? "the heap on huge pages" : "the heap on the system's pages");
 
   if (FLAGS_config_keys_markdown) {
     Config defaults;
@@ -230,8 +248,6 @@ int Main(int argc, char** argv) {
 }  // namespace finecap
 
 int main(int argc, char** argv) {
-  finecap::UseOneMallocArena();
-  finecap::BackHeapWithHugePages(1 << 30);
   try {
     return finecap::Main(argc, argv);
   } catch (const finecap::Error& error) {

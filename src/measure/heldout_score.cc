@@ -176,8 +176,8 @@ cv::Mat NccMap(const HeldOutWindows& windows, const cv::Mat& warped_grey, const 
 
 // Rows of the held-out view whose NCC is computed at once. The window statistics are images of
 // doubles, and over a whole full-size photo (2832 x 2128: 48 MB each) every one of the dozens a
-// pair makes would exceed the largest block the heap holds (heap.h), be mapped on its own and
-// faulted in page by page; a band of 128 rows (and the window's half above and below it) keeps
+// pair makes would exceed the largest block the heap holds (util/process.h), be mapped on its own
+// and faulted in page by page; a band of 128 rows (and the window's half above and below it) keeps
 // them in the heap and in the caches, and lets the bands run in parallel.
 constexpr int kBandRows = 128;
 

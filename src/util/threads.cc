@@ -1,6 +1,5 @@
 #include "finecap/util/threads.h"
 
-#include <malloc.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -15,8 +14,6 @@ void SetWorkerThreads(int threads) {
   static const int default_threads = omp_get_max_threads();
   omp_set_num_threads(threads > 0 ? threads : default_threads);
 }
-
-void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }
 
 std::vector<std::exception_ptr> ParallelForKeepingFailures(int count,
                                                            const std::function<void(int)>& task) {

@@ -83,7 +83,7 @@ struct FrameStats {
   // The bytes the heap holds in live blocks when the frame was done (glibc's mallinfo2: uordblks
   // and hblkhd), MB of 2^20 bytes; 0 where another allocator replaces glibc's (the sanitizers).
   // Where peak_rss_mb also counts pages that were touched once and kept (the heap is not given
-  // back, and is backed by 2 MB pages: heap.h), this is what a leak would make grow. Frames
+  // back, and is backed by 2 MB pages: util/process.h), this is what a leak would make grow. Frames
   // prepared ahead on other threads make it vary by a few MB from frame to frame.
   double heap_in_use_mb = 0.0;
 };

@@ -1,4 +1,4 @@
-#include "finecap/util/heap.h"
+#include "finecap/util/process.h"
 
 #include <malloc.h>
 #include <sys/mman.h>
@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+
+#include "util/option_checks.h"
 
 namespace finecap {
 namespace {
@@ -22,6 +24,18 @@ constexpr int kLargestHeapBlock = 32 << 20;
 constexpr int kDefaultTopPad = 128 << 10;
 
 }  // namespace
+
+void ProcessOptions::Check() const {
+  internal::RequireFieldRange(huge_page_heap_mb, 0, 2047, "ProcessOptions::huge_page_heap_mb");
+}
+
+bool ApplyProcessOptions(const ProcessOptions& options) {
+  options.Check();
+  if (options.one_malloc_arena) UseOneMallocArena();
+  return BackHeapWithHugePages(options.huge_page_heap_mb << 20);
+}
+
+void UseOneMallocArena() { mallopt(M_ARENA_MAX, 1); }
 
 bool BackHeapWithHugePages(int reserve_bytes) {
   if (!kMallocIsGlibcs || reserve_bytes <= 0) return false;

@@ -1,4 +1,4 @@
-#include "finecap/util/heap.h"
+#include "finecap/util/process.h"
 
 #include <cstdint>
 #include <fstream>
@@ -7,6 +7,8 @@
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
@@ -51,6 +53,16 @@ TEST(BackHeapWithHugePagesTest, LaterBlocksLieInHugePageMemory) {
 
 TEST(BackHeapWithHugePagesTest, NothingToReserveChangesNothing) {
   EXPECT_FALSE(BackHeapWithHugePages(0));
+  EXPECT_FALSE(ApplyProcessOptions({.one_malloc_arena = false, .huge_page_heap_mb = 0}));
+}
+
+TEST(ProcessOptionsTest, RefusesAReservationOutOfRange) {
+  for (int megabytes : {-1, 2048}) {
+    ProcessOptions options;
+    options.huge_page_heap_mb = megabytes;
+    EXPECT_THROW(options.Check(), Error) << megabytes;
+  }
+  EXPECT_NO_THROW(ProcessOptions().Check());
 }
 
 }  // namespace
