@@ -7,8 +7,8 @@
 #      last 100 frames may exceed that over frames 50-149 by at most 10 %. The peak resident
 #      memory (peak_rss_mb, getrusage's high-water mark) also counts heap pages that a frame
 #      touched once and that are kept for the next (util/process.h), in steps of the 2 MB pages
-#      the heap is backed by: the last frame's may exceed frame 50's by at most 10 % or two such pages,
-#      whichever is more (on the 2026-12-04 runs: live blocks flat at 5.4-7.0 MB from frame 50 to
+#      the heap is backed by: the last frame's may exceed frame 50's by at most 10 % or two such
+#      pages, whichever is more (on the 2026-12-04 runs: live blocks flat at 5.4-7.0 MB from frame 50 to
 #      950 while one 2 MB page was touched for the first time between frames 600 and 800);
 #   2. killed with SIGKILL in the middle of a frame about every KILL_EVERY frames (half a frame's
 #      time after a frame's record appears, while the next one is solved) and resumed each time
