@@ -102,7 +102,8 @@ internal::ColmapCameraRecord ReadCameraRecord(LittleEndianReader* file, int came
   camera.model = ModelName(file->Int32(record + "'s model id"), camera.where);
   const uint64_t width = file->Uint64(record + "'s width");
   const uint64_t height = file->Uint64(record + "'s height");
-  // Larger than any image: kept out of the signed record, whose check names the size.
+  // A damaged size may not fit the record's signed integers: capped far above any image, it is
+  // still refused, by the size check every model shares.
   constexpr uint64_t kTooLarge = uint64_t{1} << 40;
   camera.width = static_cast<long long>(std::min(width, kTooLarge));
   camera.height = static_cast<long long>(std::min(height, kTooLarge));

@@ -42,11 +42,12 @@ class Capture {
   // Opens and checks `dir` cheaply, so that a broken capture fails before any work: the folder
   // exists; the rig reads and every camera is valid (an intri/extri rig without image sizes gets
   // them from each camera's first image); there is at least one mesh and the first one is a valid
-  // mesh; every camera has images/<camera>/ or videos/<camera>.*; the first image of every camera
-  // decodes and has the camera's size; mask.txt and gt/textureless.txt, when present, hold valid
-  // ids. Later frames are checked when read. Throws Error naming the file and the problem.
-  // `mesh`, when not empty, is the coarse mesh of a one-frame capture, named after its stem,
-  // instead of meshes/ or a meshed-*.ply (a relative path is from the working directory).
+  // mesh; every camera has images/<camera>/ or videos/<camera>.* (or, from a COLMAP model, the
+  // image it names); the first image of every camera decodes and has the camera's size; mask.txt
+  // and gt/textureless.txt, when present, hold valid ids. Later frames are checked when read.
+  // Throws Error naming the file and the problem. `mesh`, when not empty, is the coarse mesh of a
+  // one-frame capture, named after its stem, instead of meshes/ or a meshed-*.ply (a relative path
+  // is from the working directory).
   static Capture Open(const std::string& dir, const std::string& mesh = "");
 
   Capture(Capture&&) = default;
