@@ -14,7 +14,7 @@ PACKAGES=(
   libjs-three  # the report's 3D view; a test opens it in chromium (scripts/check-report.sh)
   chromium fonts-dejavu-core  # headless, for that test; without them it would skip
   clang-14 libclang-rt-14-dev
-  colmap  # a test reads the text model COLMAP writes itself; 4 MB download, 16 MB installed
+  colmap  # tests read the text and binary models COLMAP writes itself; 4 MB download, 16 MB installed
 )
 
 missing=()

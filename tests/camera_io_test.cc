@@ -244,7 +244,8 @@ Eigen::Vector2d ColmapProject(const std::string& model, const std::vector<double
   const double r2 = x * x + y * y;
   double fx = p[0], fy = p[0], cx = p[1], cy = p[2];
   double xd = x, yd = y;
-  if (model == "PINHOLE" || model == "OPENCV") fy = p[1], cx = p[2], cy = p[3];
+  const bool two_focals = model == "PINHOLE" || model == "OPENCV" || model == "FULL_OPENCV";
+  if (two_focals) fy = p[1], cx = p[2], cy = p[3];
   if (model == "SIMPLE_RADIAL") xd = x * (1 + p[3] * r2), yd = y * (1 + p[3] * r2);
   if (model == "RADIAL") {
     const double radial = 1 + p[3] * r2 + p[4] * r2 * r2;
@@ -253,6 +254,14 @@ Eigen::Vector2d ColmapProject(const std::string& model, const std::vector<double
   if (model == "OPENCV") {
     const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];
     const double radial = 1 + k1 * r2 + k2 * r2 * r2;
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+    yd = y * radial + 2 * p2 * x * y + p1 * (r2 + 2 * y * y);
+  }
+  if (model == "FULL_OPENCV") {
+    const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];
+    const double k3 = p[8], k4 = p[9], k5 = p[10], k6 = p[11];
+    const double r4 = r2 * r2, r6 = r4 * r2;
+    const double radial = (1 + k1 * r2 + k2 * r4 + k3 * r6) / (1 + k4 * r2 + k5 * r4 + k6 * r6);
     xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
     yd = y * radial + 2 * p2 * x * y + p1 * (r2 + 2 * y * y);
   }
@@ -284,7 +293,7 @@ TEST_P(ColmapModelTest, ProjectsLikeColmapShiftedByHalfAPixel) {
          << "10.5 20.5 -1 30.5 40.5 12\n";
   WriteText(dir + "/images.txt", images.str());
 
-  const std::vector<Camera> cameras = ReadColmapTextModel(dir);
+  const std::vector<Camera> cameras = ReadColmapTextModel(dir).cameras;
   ASSERT_EQ(cameras.size(), 1u);
   EXPECT_EQ(cameras[0].name, "cam03");
   EXPECT_EQ(cameras[0].width, 800);
@@ -305,7 +314,10 @@ INSTANTIATE_TEST_SUITE_P(
                       ColmapModelCase{"PINHOLE", {700, 710, 401, 299}},
                       ColmapModelCase{"SIMPLE_RADIAL", {700, 401, 299, -0.12}},
                       ColmapModelCase{"RADIAL", {700, 401, 299, -0.12, 0.03}},
-                      ColmapModelCase{"OPENCV", {700, 710, 401, 299, -0.12, 0.03, 0.002, -0.001}}),
+                      ColmapModelCase{"OPENCV", {700, 710, 401, 299, -0.12, 0.03, 0.002, -0.001}},
+                      ColmapModelCase{"FULL_OPENCV",
+                                      {700, 710, 401, 299, -0.12, 0.03, 0.002, -0.001, 0.004, 0.05,
+                                       -0.01, 0.002}}),
     [](const ::testing::TestParamInfo<ColmapModelCase>& info) { return info.param.model; });
 
 // Runs `command` with sh; its output goes to `log`. True when it exits 0.
@@ -377,7 +389,7 @@ TEST(ColmapTextModelTest, ReadsWhatColmapItselfWrote) {
   const std::string written = testing_util::FileBytes(dir + "/colmap/cameras.txt");
   ASSERT_NE(written.find("# Camera list"), std::string::npos) << "not COLMAP's own header";
 
-  const std::vector<Camera> cameras = ReadColmapTextModel(dir + "/colmap");
+  const std::vector<Camera> cameras = ReadColmapTextModel(dir + "/colmap").cameras;
   ASSERT_EQ(cameras.size(), known.size());
   for (size_t i = 0; i < known.size(); ++i) {
     const Camera& expected = known[i].camera;
@@ -404,7 +416,9 @@ TEST(ColmapTextModelTest, NamesCamerasAndTakesTheSmallestImageIdPerCamera) {
             "\n"
             "4 1 0 0 0 0 0 2 1 cam1/000000.png\n"
             "1.0 2.0 -1\n");
-  const std::vector<Camera> cameras = ReadColmapTextModel(dir);
+  const ColmapModel model = ReadColmapTextModel(dir);
+  EXPECT_EQ(model.image_names, (std::vector<std::string>{"side.png", "cam1/000000.png"}));
+  const std::vector<Camera>& cameras = model.cameras;
   ASSERT_EQ(cameras.size(), 2u);
   EXPECT_EQ(cameras[0].name, "side");
   EXPECT_EQ(cameras[0].fx(), 600.0);
@@ -417,9 +431,9 @@ TEST(ColmapTextModelTest, BadInputsNameTheFileAndProblem) {
   const std::string dir = MakeTempDir("colmap");
   const std::string good_images = "1 1 0 0 0 0 0 1 1 cam0.png\n\n";
   WriteText(dir + "/images.txt", good_images);
-  WriteText(dir + "/cameras.txt", "1 FULL_OPENCV 640 480 1 1 1 1 0 0 0 0 0 0 0 0\n");
+  WriteText(dir + "/cameras.txt", "1 OPENCV_FISHEYE 640 480 1 1 1 1 0 0 0 0\n");
   ExpectErrorMentions([&] { ReadColmapTextModel(dir); },
-                      {"cameras.txt line 1", "unsupported camera model 'FULL_OPENCV'"});
+                      {"cameras.txt line 1", "unsupported camera model 'OPENCV_FISHEYE'"});
   WriteText(dir + "/cameras.txt", "# header\n1 PINHOLE 640 480 500 500 320\n");
   ExpectErrorMentions([&] { ReadColmapTextModel(dir); },
                       {"cameras.txt line 2", "takes 4 parameters, not 3"});
@@ -510,16 +524,19 @@ TEST(IntriExtriTest, BadInputsNameTheFileAndKey) {
 TEST(ReadRigTest, FindsEachFormat) {
   const std::string yaml_dir = MakeTempDir("rig");
   WriteCamerasYaml({MakeCamera("cam0", 0.3)}, yaml_dir + "/cameras.yaml");
-  EXPECT_EQ(ReadRig(yaml_dir).at(0).name, "cam0");
+  EXPECT_EQ(ReadRig(yaml_dir).cameras.at(0).name, "cam0");
 
   const std::string intri_dir = MakeTempDir("rig");
   WriteIntriExtri(intri_dir, MakeCamera("a", 0.3), MakeCamera("b", 0.1));
-  EXPECT_EQ(ReadRig(intri_dir).size(), 2u);
+  EXPECT_EQ(ReadRig(intri_dir).cameras.size(), 2u);
 
   const std::string colmap_dir = MakeTempDir("rig");
   WriteText(colmap_dir + "/sparse/0/cameras.txt", "1 PINHOLE 640 480 500 500 320 240\n");
   WriteText(colmap_dir + "/sparse/0/images.txt", "1 1 0 0 0 0 0 1 1 c/0.png\n\n");
-  EXPECT_EQ(ReadRig(colmap_dir).at(0).name, "c");
+  const Rig colmap = ReadRig(colmap_dir);
+  EXPECT_EQ(colmap.cameras.at(0).name, "c");
+  EXPECT_EQ(colmap.source, "COLMAP text model in sparse/0");
+  EXPECT_EQ(colmap.colmap_images, std::vector<std::string>{colmap_dir + "/images/c/0.png"});
 
   const std::string empty_dir = MakeTempDir("rig");
   ExpectErrorMentions([&] { ReadRig(empty_dir); }, {empty_dir, "no camera rig found"});

@@ -202,12 +202,12 @@ TEST(CalibTomlTest, ReadRigFindsItAndRefusesTwo) {
   const std::string dir = MakeTempDir("toml");
   WriteText(dir + "/Config.toml", "[project]\nframe_rate = 60\n");  // Pose2Sim's, not a rig.
   WriteText(dir + "/Calib.toml", AniposeToml(FourCameraRig()));
-  std::string source;
-  EXPECT_EQ(ReadRig(dir, &source).size(), 4u);
-  EXPECT_EQ(source, "Calib.toml (Pose2Sim/anipose)");
+  const Rig rig = ReadRig(dir);
+  EXPECT_EQ(rig.cameras.size(), 4u);
+  EXPECT_EQ(rig.source, "Calib.toml (Pose2Sim/anipose)");
   const std::string freemocap = MakeTempDir("toml");
   WriteText(freemocap + "/take1_camera_calibration.toml", AniposeToml(FourCameraRig()));
-  EXPECT_EQ(ReadRig(freemocap).size(), 4u);
+  EXPECT_EQ(ReadRig(freemocap).cameras.size(), 4u);
   WriteText(dir + "/calib_old.TOML", AniposeToml(FourCameraRig()));
   ExpectErrorMentions([&] { ReadRig(dir); },
                       {dir, "Calib.toml", "calib_old.TOML", "more than one"});

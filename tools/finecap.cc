@@ -23,6 +23,9 @@ DECLARE_bool(help);
 
 DEFINE_string(config, "", "YAML config file; every key is listed by `finecap --help`.");
 DEFINE_string(capture, "", "Capture folder; overrides capture.dir.");
+DEFINE_string(mesh, "",
+              "Coarse mesh of a one-frame capture (a COLMAP workspace, say); overrides "
+              "capture.mesh.");
 DEFINE_string(out, "", "Output folder; overrides output.dir.");
 DEFINE_string(frames, "", "Frames to process, A:B (indices A..B-1); overrides capture.frames.");
 DEFINE_int32(threads, -1, "Worker threads (0 = all cores); overrides runtime.threads.");
@@ -66,45 +69,45 @@ const std::vector<Subcommand>& Subcommands() {
        "new folder under $TMPDIR (default /tmp), never into the current directory.",
        "finecap probe --config FILE --capture DIR [--frame N] [--out DIR]",
        [](const Config& config) { return RunProbe(config, FLAGS_frame); },
-       {"config", "capture", "out", "frame", "set"}},
+       {"config", "capture", "mesh", "out", "frame", "set"}},
       {"export",
        "Write a refined run for animation tools: a PC2 point cache (Blender's Mesh Cache) and "
        "per-frame PLY with the displacement as vertex quality (MeshLab).",
        "finecap export --config FILE [--capture DIR] [--out DIR] [--frames A:B]",
        &RunExport,
-       {"config", "capture", "out", "frames", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "set"}},
       {"refine",
        "Refine the coarse meshes of a capture with fine surface detail.",
        "finecap refine --config configs/demo.yaml [--frames A:B] [--shard I/N] [--solver "
        "ceres|gradient-ascent|lbfgs]"
-       " [--capture DIR] [--out DIR]",
+       " [--capture DIR] [--mesh FILE] [--out DIR]",
        &RunRefine,
-       {"config", "capture", "out", "frames", "shard", "solver", "threads", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "shard", "solver", "threads", "set"}},
       {"info",
        "Show the capture as finecap reads it and what refining it would take (lengths chosen "
        "from the scene, vertices refined, memory and time per frame), without refining or "
        "writing anything.",
        "finecap info --config FILE [--capture DIR] [--frames A:B] [--shard I/N] [--solver ...]",
        &RunInfo,
-       {"config", "capture", "out", "frames", "shard", "solver", "threads", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "shard", "solver", "threads", "set"}},
       {"status",
        "List the configured frames (of one shard with --shard) that a refine output folder "
        "lacks; exit code 0 when none, 3 when some are missing.",
        "finecap status --config FILE [--capture DIR] [--out DIR] [--frames A:B] [--shard I/N]",
        &RunStatus,
-       {"config", "capture", "out", "frames", "shard", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "shard", "set"}},
       {"eval",
        "Measure a refined run against the capture's ground truth: pictures, plots, "
        "eval/metrics.json and eval/report.html in the output folder.",
        "finecap eval --config FILE [--capture DIR] [--out DIR] [--frames A:B]",
        &RunEval,
-       {"config", "capture", "out", "frames", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "set"}},
       {"compare",
        "Refine the same frames with several variants (section compare) and compare them: "
        "comparison.csv, comparison.md, convergence plots and report.html in the output folder.",
        "finecap compare --config configs/compare_solvers.yaml [--frames A:B] [--out DIR]",
        &RunCompare,
-       {"config", "capture", "out", "frames", "threads", "set"}},
+       {"config", "capture", "mesh", "out", "frames", "threads", "set"}},
   };
   return kSubcommands;
 }
@@ -139,8 +142,8 @@ void PrintMainHelp() {
     text += "  " + std::string(subcommand.name) + "\n      " + subcommand.summary + "\n";
   }
   text += "\nFlags (a flag overrides its config key):\n";
-  for (const char* flag :
-       {"config", "capture", "out", "frames", "shard", "solver", "frame", "threads", "set"}) {
+  for (const char* flag : {"config", "capture", "mesh", "out", "frames", "shard", "solver", "frame",
+                           "threads", "set"}) {
     text += FlagHelp(flag);
   }
   text += "\nProcess settings (finecap/util/process.h; the defaults are what measured best):\n";
@@ -177,6 +180,7 @@ std::vector<ConfigOverride> ParseSetFlag(const std::string& text) {
 std::vector<ConfigOverride> FlagOverrides() {
   std::vector<ConfigOverride> overrides;
   if (!FLAGS_capture.empty()) overrides.push_back({"capture.dir", FLAGS_capture, "--capture"});
+  if (!FLAGS_mesh.empty()) overrides.push_back({"capture.mesh", FLAGS_mesh, "--mesh"});
   if (!FLAGS_out.empty()) overrides.push_back({"output.dir", FLAGS_out, "--out"});
   if (!FLAGS_frames.empty()) overrides.push_back({"capture.frames", FLAGS_frames, "--frames"});
   if (!FLAGS_shard.empty()) overrides.push_back({"runtime.shard", FLAGS_shard, "--shard"});

@@ -47,7 +47,7 @@ void CheckHeldOutCameras(const Config& config, const Capture& capture) {
 Capture OpenConfiguredCapture(const Config& config) {
   Require(!config.capture.dir.empty(), "capture.dir",
           "no capture folder given (set capture.dir or pass --capture DIR)");
-  Capture capture = Capture::Open(config.capture.dir);
+  Capture capture = Capture::Open(config.capture.dir, config.capture.mesh);
   CheckHeldOutCameras(config, capture);
   return capture;
 }

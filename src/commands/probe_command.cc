@@ -44,7 +44,7 @@ int RunProbe(const Config& configured, int frame_index) {
           "frame " + std::to_string(frame) + " does not exist in " + capture.directory());
   RequireProbeableFrame(capture, frame);
   const SequenceModel model(capture.ReadCoarseMesh(0), capture.vertex_mask(), config.refine,
-                            capture.directory() + "/meshes");
+                            capture.mesh_path(0));
   const std::string out = ProbeOutputFolder(config, capture);
   const ReferenceColors colors = internal::ConfiguredReferenceColors(config, model, &capture, out);
   const EnergyProbe probe = ProbeEnergyAlongTruth(&capture, frame, model, colors, config.refine,

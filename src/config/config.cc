@@ -96,6 +96,9 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
   schema->AddString(
       "capture.dir", &config->capture.dir,
       "Capture folder (cameras, images or videos, meshes; see docs/capture-format.md).");
+  schema->AddString("capture.mesh", &config->capture.mesh,
+                    "Coarse mesh of a one-frame capture (e.g. a COLMAP workspace), instead of its "
+                    "meshes/ folder or COLMAP's meshed-*.ply; \"\" = the capture's own.");
   schema->AddString("capture.frames", &config->capture.frames,
                     "Frames to process: \"A:B\" = indices A..B-1 of the sorted frame list; "
                     "\"\" = all.");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <utility>
 
 #include "finecap/util/error.h"
 #include "util/io_util.h"
@@ -31,21 +32,35 @@ std::vector<fs::path> CalibTomlFiles(const fs::path& dir) {
   return files;
 }
 
+// The COLMAP model of a capture folder, binary or text, with its images under images/.
+Rig ReadColmapRig(const fs::path& dir, const fs::path& folder, bool binary) {
+  std::error_code error;
+  const std::string relative = fs::relative(folder, dir, error).string();
+  Rig rig;
+  rig.source = std::string("COLMAP ") + (binary ? "binary" : "text") + " model" +
+               (relative == "." ? std::string() : " in " + relative);
+  ColmapModel model =
+      binary ? ReadColmapBinaryModel(folder.string()) : ReadColmapTextModel(folder.string());
+  rig.cameras = std::move(model.cameras);
+  for (const std::string& name : model.image_names) {
+    rig.colmap_images.push_back((dir / "images" / name).string());
+  }
+  return rig;
+}
+
 }  // namespace
 
-std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source) {
+Rig ReadRig(const std::string& capture_dir) {
   const fs::path dir(capture_dir);
   std::error_code error;
-  std::string unused;
-  std::string& read_from = source != nullptr ? *source : unused;
   Require(fs::is_directory(dir, error), capture_dir, "capture folder not found");
   if (fs::exists(dir / "cameras.yaml", error)) {
-    read_from = "cameras.yaml";
-    return ReadCamerasYaml((dir / "cameras.yaml").string());
+    return {ReadCamerasYaml((dir / "cameras.yaml").string()), "cameras.yaml", {}};
   }
   if (fs::exists(dir / "intri.yml", error) || fs::exists(dir / "extri.yml", error)) {
-    read_from = "intri.yml + extri.yml";
-    return ReadIntriExtri((dir / "intri.yml").string(), (dir / "extri.yml").string());
+    return {ReadIntriExtri((dir / "intri.yml").string(), (dir / "extri.yml").string()),
+            "intri.yml + extri.yml",
+            {}};
   }
   const std::vector<fs::path> tomls = CalibTomlFiles(dir);
   if (tomls.size() > 1) {
@@ -55,20 +70,19 @@ std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source)
                                  "): keep the one that calibrates these images");
   }
   if (tomls.size() == 1) {
-    read_from = tomls.front().filename().string() + " (Pose2Sim/anipose)";
-    return ReadCalibToml(tomls.front().string());
+    return {ReadCalibToml(tomls.front().string()),
+            tomls.front().filename().string() + " (Pose2Sim/anipose)",
+            {}};
   }
   for (const fs::path& folder : {dir / "sparse", dir / "sparse" / "0", dir}) {
-    if (fs::exists(folder / "cameras.txt", error)) {
-      const std::string relative = fs::relative(folder, dir, error).string();
-      read_from = "COLMAP text model" + (relative == "." ? std::string() : " in " + relative);
-      return ReadColmapTextModel(folder.string());
-    }
+    // COLMAP itself reads the binary model when both are there.
+    if (fs::exists(folder / "cameras.bin", error)) return ReadColmapRig(dir, folder, true);
+    if (fs::exists(folder / "cameras.txt", error)) return ReadColmapRig(dir, folder, false);
   }
   throw Error(capture_dir,
               "no camera rig found: expected cameras.yaml, intri.yml + extri.yml, a Calib.toml "
-              "(Pose2Sim, anipose) or a COLMAP text model (cameras.txt + images.txt in sparse/, "
-              "sparse/0/ or the folder itself)");
+              "(Pose2Sim, anipose) or a COLMAP model (cameras.bin + images.bin or cameras.txt + "
+              "images.txt in sparse/, sparse/0/ or the folder itself)");
 }
 
 }  // namespace finecap

@@ -42,18 +42,19 @@ void SortFrameNames(std::vector<std::string>* names) {
   }
 }
 
-// images/<camera> if present, else the video videos/<camera>.<any extension>; empty if neither.
-std::string FindCameraStream(const fs::path& dir, const std::string& camera_name) {
+// The meshes COLMAP's poisson_mesher and delaunay_mesher write into a dense workspace.
+std::vector<fs::path> ColmapMeshes(const fs::path& dir) {
+  std::vector<fs::path> meshes;
   std::error_code error;
-  const fs::path images = dir / "images" / camera_name;
-  if (fs::is_directory(images, error)) return images.string();
-  if (!fs::is_directory(dir / "videos", error)) return "";
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir / "videos", error)) {
-    if (entry.is_regular_file(error) && entry.path().stem() == camera_name) {
-      return entry.path().string();
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("meshed-", 0) == 0 && entry.path().extension() == ".ply" &&
+        entry.is_regular_file(error)) {
+      meshes.push_back(entry.path());
     }
   }
-  return "";
+  std::sort(meshes.begin(), meshes.end());
+  return meshes;
 }
 
 Eigen::VectorXd ParseDisplacements(const std::string& path, int num_vertices) {
@@ -77,26 +78,56 @@ Eigen::VectorXd ParseDisplacements(const std::string& path, int num_vertices) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), num_vertices);
 }
 
+// The camera's images, checked to exist: what is missing is named, for a COLMAP camera the image
+// the model names.
+std::string RequireCameraStream(const std::string& stream, const Camera& camera,
+                                const std::string& colmap_image, const std::string& rig_source,
+                                const std::string& dir) {
+  const std::string elsewhere =
+      "an image folder images/" + camera.name + "/ nor a video videos/" + camera.name + ".*";
+  if (colmap_image.empty()) {
+    Require(!stream.empty(), dir, "camera " + camera.name + " has neither " + elsewhere);
+  } else {
+    Require(!stream.empty(), colmap_image,
+            "not found: the " + rig_source + " names it as the image of camera " + camera.name +
+                ", and there is neither " + elsewhere);
+  }
+  return stream;
+}
+
 }  // namespace
 
-Capture Capture::Open(const std::string& dir) {
+Capture Capture::Open(const std::string& dir, const std::string& mesh) {
   std::error_code error;
   Require(fs::is_directory(dir, error), dir, "capture folder not found");
   Capture capture;
   capture.directory_ = dir;
-  capture.rig_ = ReadRig(dir, &capture.rig_source_);
-  capture.FindFrames();
-  capture.ReadCameras();
+  Rig rig = ReadRig(dir);
+  capture.rig_ = std::move(rig.cameras);
+  capture.rig_source_ = std::move(rig.source);
+  capture.FindFrames(mesh);
+  capture.ReadCameras(rig.colmap_images);
   capture.OpenFrameSources();
   capture.ReadOptionalFiles();
   return capture;
 }
 
-void Capture::FindFrames() {
+void Capture::FindFrames(const std::string& mesh) {
+  std::error_code error;
+  if (!mesh.empty()) {
+    frame_names_ = {fs::path(mesh).stem().string()};
+    mesh_paths_ = {mesh};
+  } else if (fs::is_directory(fs::path(directory_) / "meshes", error)) {
+    FindFramesInMeshFolder();
+  } else {
+    FindColmapMesh();
+  }
+  first_mesh_ = ReadMesh(mesh_paths_[0]);
+}
+
+void Capture::FindFramesInMeshFolder() {
   const fs::path meshes = fs::path(directory_) / "meshes";
   std::error_code error;
-  Require(fs::is_directory(meshes, error), meshes.string(),
-          "mesh folder not found (one coarse mesh per frame is needed)");
   std::map<std::string, std::string> path_of_frame;
   for (const fs::directory_entry& entry : fs::directory_iterator(meshes, error)) {
     const fs::path& path = entry.path();
@@ -108,18 +139,55 @@ void Capture::FindFrames() {
   for (const auto& entry : path_of_frame) frame_names_.push_back(entry.first);
   SortFrameNames(&frame_names_);
   for (const std::string& name : frame_names_) mesh_paths_.push_back(path_of_frame[name]);
-  first_mesh_ = ReadMesh(mesh_paths_[0]);
+}
+
+// The mesh of a COLMAP dense workspace, its one frame.
+void Capture::FindColmapMesh() {
+  const std::vector<fs::path> meshes = ColmapMeshes(directory_);
+  Require(!meshes.empty(), (fs::path(directory_) / "meshes").string(),
+          "mesh folder not found (one coarse mesh per frame is needed; a one-frame capture may "
+          "instead give its mesh with --mesh FILE or hold COLMAP's meshed-poisson.ply or "
+          "meshed-delaunay.ply)");
+  if (meshes.size() > 1) {
+    std::vector<std::string> names;
+    for (const fs::path& path : meshes) names.push_back(path.filename().string());
+    throw Error(directory_, "more than one COLMAP mesh (" + internal::JoinWithCommas(names) +
+                                "): choose one with --mesh FILE");
+  }
+  frame_names_ = {meshes[0].stem().string()};
+  mesh_paths_ = {meshes[0].string()};
+}
+
+// images/<camera>/ if present, else the video videos/<camera>.<any extension>, else the image of
+// a COLMAP model (images/NAME); empty if none.
+std::string Capture::FindCameraStream(const Camera& camera, const std::string& colmap_image) const {
+  const fs::path dir(directory_);
+  std::error_code error;
+  const fs::path images = dir / "images" / camera.name;
+  if (fs::is_directory(images, error)) return images.string();
+  if (fs::is_directory(dir / "videos", error)) {
+    for (const fs::directory_entry& entry : fs::directory_iterator(dir / "videos", error)) {
+      if (entry.is_regular_file(error) && entry.path().stem() == camera.name) {
+        return entry.path().string();
+      }
+    }
+  }
+  if (!colmap_image.empty() && fs::is_regular_file(colmap_image, error)) return colmap_image;
+  return "";
 }
 
 // Fills in the image size of rigs that do not state it (intri/extri), from the first image.
-void Capture::ReadCameras() {
-  for (Camera& camera : rig_) {
-    const std::string stream = FindCameraStream(directory_, camera.name);
-    Require(!stream.empty(), directory_,
-            "camera " + camera.name + " has neither an image folder images/" + camera.name +
-                "/ nor a video videos/" + camera.name + ".*");
+void Capture::ReadCameras(const std::vector<std::string>& colmap_images) {
+  for (size_t c = 0; c < rig_.size(); ++c) {
+    Camera& camera = rig_[c];
+    const std::string colmap_image = colmap_images.empty() ? "" : colmap_images[c];
+    streams_.push_back(RequireCameraStream(FindCameraStream(camera, colmap_image), camera,
+                                           colmap_image, rig_source_, directory_));
+    Require(streams_.back() != colmap_image || num_frames() == 1, colmap_image,
+            "a single image (COLMAP's flat images/ layout) holds one frame, but the capture has " +
+                std::to_string(num_frames()) + " meshes");
     if (camera.width == 0 && camera.height == 0) {
-      const cv::Size size = ReadFirstFrameSize(stream, frame_names_);
+      const cv::Size size = ReadFirstFrameSize(streams_.back(), frame_names_);
       camera.width = size.width;
       camera.height = size.height;
     }
@@ -129,9 +197,8 @@ void Capture::ReadCameras() {
 }
 
 void Capture::OpenFrameSources() {
-  for (const Camera& camera : rig_) {
-    sources_.push_back(
-        OpenFrameSource(FindCameraStream(directory_, camera.name), frame_names_, camera));
+  for (size_t c = 0; c < rig_.size(); ++c) {
+    sources_.push_back(OpenFrameSource(streams_[c], frame_names_, rig_[c]));
   }
   // Decodes and checks the first image of each camera, the cameras side by side; a failure is
   // reported as the cameras taken in the rig's order would meet it.

@@ -156,6 +156,32 @@ class ImageFolderSource : public FrameSource {
   Undistorter undistorter_;
 };
 
+// One image file, the only frame: COLMAP's flat images/NAME layout.
+class ImageFileSource : public FrameSource {
+ public:
+  ImageFileSource(const std::string& path, const Camera& camera)
+      : path_(path), camera_(camera), undistorter_(camera) {}
+
+  cv::Mat Read(int frame) override {
+    RequireFrameInRange(frame, num_frames(), path_);
+    const cv::Mat image = DecodeImageFile(path_);
+    RequireCameraSize(image, camera_, path_);
+    return undistorter_.Apply(image);
+  }
+
+  int num_frames() const override { return 1; }
+
+ private:
+  std::string path_;
+  Camera camera_;
+  Undistorter undistorter_;
+};
+
+bool IsImageFile(const std::string& path) {
+  std::error_code error;
+  return fs::is_regular_file(path, error) && IsImageExtension(fs::path(path).extension().string());
+}
+
 // The video at `path` through the OpenCV extras (src/util/opencv_extras.h), which are loaded
 // here, by the first video a run opens.
 std::unique_ptr<internal::VideoReader> OpenVideo(const std::string& path) {
@@ -236,6 +262,13 @@ std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path,
   std::error_code error;
   Require(fs::exists(path, error), path, "no images or video found here");
   if (fs::is_directory(path, error)) return MakeImageFolderSource(path, frame_names, camera);
+  if (IsImageFile(path)) {
+    Require(
+        frame_names.size() == 1, path,
+        "a single image holds one frame, not the " + std::to_string(frame_names.size()) + " asked");
+    camera.Validate(path);
+    return std::make_unique<ImageFileSource>(path, camera);
+  }
   return MakeVideoSource(path, static_cast<int>(frame_names.size()), camera);
 }
 
@@ -245,6 +278,7 @@ cv::Size ReadFirstFrameSize(const std::string& path, const std::vector<std::stri
   if (fs::is_directory(path, error)) {
     return DecodeImageFile(ImageFolderIndex(path).Find(frame_names[0])).size();
   }
+  if (IsImageFile(path)) return DecodeImageFile(path).size();
   cv::Mat image;
   Require(OpenVideo(path)->Read(&image) && !image.empty(), path, "the video has no frames");
   return image.size();

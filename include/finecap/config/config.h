@@ -23,6 +23,10 @@ namespace finecap {
 struct CaptureConfig {
   // Capture folder (layout: docs/capture-format.md); a relative path is from the working directory.
   std::string dir;
+  // The coarse mesh of a one-frame capture (a COLMAP workspace, say), named after its file stem,
+  // instead of the capture's meshes/ folder or COLMAP's meshed-*.ply; a relative path is from the
+  // working directory. "" (default): the capture's own.
+  std::string mesh;
   // Frames to process, "A:B" = indices A to B-1 of the sorted frame list; "" = all frames.
   std::string frames;
   // When a camera's image of a frame cannot be read (missing, empty, truncated, undecodable, of

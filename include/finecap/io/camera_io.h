@@ -38,15 +38,30 @@ namespace finecap {
 std::vector<Camera> ReadCamerasYaml(const std::string& path);
 void WriteCamerasYaml(const std::vector<Camera>& cameras, const std::string& path);
 
-// A COLMAP text model: `folder`/cameras.txt and `folder`/images.txt. Supports the PINHOLE,
-// SIMPLE_PINHOLE, SIMPLE_RADIAL, RADIAL and OPENCV camera models; COLMAP's pixel centres sit at
-// +0.5 (the top-left pixel's centre is (0.5, 0.5)), which the reader subtracts from the principal
-// point. The pose of an image is COLMAP's world-to-camera quaternion QW QX QY QZ and translation.
+// A COLMAP model as finecap reads it: the cameras and, for each, the NAME of the image that posed
+// it (relative to COLMAP's image folder, e.g. `cam03/000000.jpg` or `cam03.jpg`).
+struct ColmapModel {
+  std::vector<Camera> cameras;
+  std::vector<std::string> image_names;  // One per camera.
+};
+
+// A COLMAP text model: `folder`/cameras.txt and `folder`/images.txt. Cameras of the models with an
+// OpenCV equivalent are read: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV and
+// FULL_OPENCV (whose k1 k2 p1 p2 k3 k4 k5 k6 are OpenCV's rational model); any other model
+// (the fisheye ones, FOV, ...) is refused by name. COLMAP's pixel centres sit at +0.5 (the
+// top-left pixel's centre is (0.5, 0.5)), which the reader subtracts from the principal point.
+// The pose of an image is COLMAP's world-to-camera quaternion QW QX QY QZ and translation.
 // A camera is named after its image: the image's folder when the NAME has one (`cam03/000000.jpg`
 // -> `cam03`), else the file stem (`cam03.jpg` -> `cam03`). When several images share a camera
 // name (several frames of one fixed camera), the one with the smallest IMAGE_ID gives the pose.
 // Cameras are returned in order of their first IMAGE_ID.
-std::vector<Camera> ReadColmapTextModel(const std::string& folder);
+ColmapModel ReadColmapTextModel(const std::string& folder);
+
+// COLMAP's binary model, `folder`/cameras.bin and `folder`/images.bin (points3D.bin is not read),
+// as COLMAP writes it (little-endian; model ids 0 to 11), giving what ReadColmapTextModel gives for
+// the same model converted to text. A truncated file, an unknown model id, trailing bytes and
+// duplicate ids are refused, naming the file and the record.
+ColmapModel ReadColmapBinaryModel(const std::string& folder);
 
 // The pair intri.yml / extri.yml of ZJU-MoCap and EasyMocap, as OpenCV's FileStorage writes it in
 // YAML (read with yaml-cpp: OpenCV's own parser can hang on a damaged file): the `names` list
@@ -81,14 +96,24 @@ std::vector<Camera> ReadIntriExtri(const std::string& intri_path, const std::str
 // and cameras that fail Camera::Validate are refused.
 std::vector<Camera> ReadCalibToml(const std::string& path);
 
+// A capture's camera rig and what it was read from.
+struct Rig {
+  std::vector<Camera> cameras;
+  // E.g. "cameras.yaml", "intri.yml + extri.yml", "Calib.toml (Pose2Sim/anipose)" or "COLMAP
+  // binary model in sparse/0".
+  std::string source;
+  // For a COLMAP model, per camera, the image that posed it: the capture folder's images/NAME.
+  // Empty for the other formats.
+  std::vector<std::string> colmap_images;
+};
+
 // The rig of a capture folder, in this order: cameras.yaml; intri.yml + extri.yml; a Calib.toml
 // (a file whose name, in any case, ends in ".toml" and contains "calib": Calib.toml,
 // Calib_board.toml, calibration.toml, take1_camera_calibration.toml; more than one such file is
-// refused as ambiguous); a COLMAP text model in `capture_dir`/sparse, `capture_dir`/sparse/0 or
-// `capture_dir` itself (the first holding a cameras.txt). Throws Error naming the folder if none
-// is found. When `source` is given it receives what the rig was read from, e.g. "cameras.yaml",
-// "intri.yml + extri.yml", "Calib.toml (Pose2Sim/anipose)" or "COLMAP text model in sparse/0".
-std::vector<Camera> ReadRig(const std::string& capture_dir, std::string* source = nullptr);
+// refused as ambiguous); a COLMAP model in `capture_dir`/sparse, `capture_dir`/sparse/0 or
+// `capture_dir` itself (the first holding a cameras.bin or cameras.txt; binary when both are
+// there, as COLMAP reads them). Throws Error naming the folder if none is found.
+Rig ReadRig(const std::string& capture_dir);
 
 }  // namespace finecap
 

@@ -2,7 +2,7 @@
 // of each frame and, for synthetic captures, the ground truth.
 //
 //   capture/
-//     cameras.yaml (or intri.yml + extri.yml, or a COLMAP text model; see camera_io.h)
+//     cameras.yaml (or intri.yml + extri.yml, a Calib.toml, or a COLMAP model; see camera_io.h)
 //     images/<camera>/<frame>.png|.jpg|.jpeg   or   videos/<camera>.<ext>
 //     meshes/<frame>.<ply|obj|off|...>          coarse mesh per frame, one topology
 //     mask.txt                                  optional: vertex ids to refine (vertex_mask.h)
@@ -15,6 +15,12 @@
 //
 // Frames are named by the mesh file stems (hidden files, e.g. unfinished writes, are ignored),
 // sorted numerically when every stem is a number (`2` before `10`), else as text.
+//
+// A COLMAP workspace is a capture too. With a COLMAP model, a camera with neither images/<camera>/
+// nor videos/<camera>.* takes the image that posed it, images/NAME (COLMAP's flat layout, where
+// NAME is `cam03.jpg` and the camera `cam03`): one image per camera, so the capture holds one
+// frame. Its mesh is the one given to Open, else meshes/ as above, else, in COLMAP's undistorted
+// dense/0/ folder, the one meshed-*.ply there (meshed-poisson.ply, meshed-delaunay.ply).
 #ifndef FINECAP_CAPTURE_H_
 #define FINECAP_CAPTURE_H_
 
@@ -36,10 +42,13 @@ class Capture {
   // Opens and checks `dir` cheaply, so that a broken capture fails before any work: the folder
   // exists; the rig reads and every camera is valid (an intri/extri rig without image sizes gets
   // them from each camera's first image); there is at least one mesh and the first one is a valid
-  // mesh; every camera has images/<camera>/ or videos/<camera>.*; the first image of every camera
-  // decodes and has the camera's size; mask.txt and gt/textureless.txt, when present, hold valid
-  // ids. Later frames are checked when read. Throws Error naming the file and the problem.
-  static Capture Open(const std::string& dir);
+  // mesh; every camera has images/<camera>/ or videos/<camera>.* (or, from a COLMAP model, the
+  // image it names); the first image of every camera decodes and has the camera's size; mask.txt
+  // and gt/textureless.txt, when present, hold valid ids. Later frames are checked when read.
+  // Throws Error naming the file and the problem. `mesh`, when not empty, is the coarse mesh of a
+  // one-frame capture, named after its stem, instead of meshes/ or a meshed-*.ply (a relative path
+  // is from the working directory).
+  static Capture Open(const std::string& dir, const std::string& mesh = "");
 
   Capture(Capture&&) = default;
   Capture& operator=(Capture&&) = default;
@@ -91,8 +100,11 @@ class Capture {
  private:
   Capture() = default;
 
-  void ReadCameras();
-  void FindFrames();
+  void ReadCameras(const std::vector<std::string>& colmap_images);
+  void FindFrames(const std::string& mesh);
+  void FindFramesInMeshFolder();
+  void FindColmapMesh();
+  std::string FindCameraStream(const Camera& camera, const std::string& colmap_image) const;
   void OpenFrameSources();
   void ReadOptionalFiles();
   void RequireFrame(int frame) const;
@@ -105,6 +117,7 @@ class Capture {
   std::vector<std::string> frame_names_;
   std::vector<std::string> mesh_paths_;
   Mesh first_mesh_;
+  std::vector<std::string> streams_;  // Per camera, its image folder, video or single image.
   std::vector<std::unique_ptr<FrameSource>> sources_;
   // Per camera, its image of frame 0, decoded as the capture opened to check it: the first
   // ReadImage of that frame takes it instead of decoding it again, and a read of any other frame

@@ -47,9 +47,11 @@ std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
 std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,
                                              const Camera& camera);
 
-// MakeImageFolderSource when `path` is a folder, else MakeVideoSource with frame_names.size().
-// The camera must have a positive size (Camera::Validate); throws Error naming `path` otherwise
-// or when it does not exist.
+// MakeImageFolderSource when `path` is a folder; the image itself, as the one frame, when it is
+// an image file (.png, .jpg, .jpeg, case ignored; COLMAP's flat layout); else MakeVideoSource
+// with frame_names.size(). The camera must have a positive size (Camera::Validate); throws Error
+// naming `path` otherwise, when it does not exist, or when an image file is asked for more than
+// one frame.
 std::unique_ptr<FrameSource> OpenFrameSource(const std::string& path,
                                              const std::vector<std::string>& frame_names,
                                              const Camera& camera);
