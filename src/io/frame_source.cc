@@ -144,19 +144,24 @@ void RequireFrameInRange(int frame, int num_frames, const std::string& where) {
           "frame " + std::to_string(frame) + " is outside [0, " + std::to_string(num_frames) + ")");
 }
 
+// The images of a folder, or its masks (ForegroundOf), one frame at a time.
 class ImageFolderSource : public FrameSource {
  public:
+  enum class Content { kImages, kMasks };
+
   ImageFolderSource(const std::string& folder, const std::vector<std::string>& frame_names,
-                    const Camera& camera)
+                    const Camera& camera, Content content)
       : folder_(folder),
         index_(folder),
         frame_names_(frame_names),
         camera_(camera),
-        undistorter_(camera) {}
+        undistorter_(camera),
+        content_(content) {}
 
   cv::Mat Read(int frame) override {
     RequireFrameInRange(frame, num_frames(), folder_);
     const std::string path = index_.Find(frame_names_[frame]);
+    if (content_ == Content::kMasks) return ReadMask(path);
     const cv::Mat image = DecodeImageFile(path);
     RequireCameraSize(image, camera_, path);
     return undistorter_.Apply(image);
@@ -165,26 +170,7 @@ class ImageFolderSource : public FrameSource {
   int num_frames() const override { return static_cast<int>(frame_names_.size()); }
 
  private:
-  std::string folder_;
-  ImageFolderIndex index_;
-  std::vector<std::string> frame_names_;
-  Camera camera_;
-  Undistorter undistorter_;
-};
-
-class MaskFolderSource : public FrameSource {
- public:
-  MaskFolderSource(const std::string& folder, const std::vector<std::string>& frame_names,
-                   const Camera& camera)
-      : folder_(folder),
-        index_(folder),
-        frame_names_(frame_names),
-        camera_(camera),
-        undistorter_(camera) {}
-
-  cv::Mat Read(int frame) override {
-    RequireFrameInRange(frame, num_frames(), folder_);
-    const std::string path = index_.Find(frame_names_[frame]);
+  cv::Mat ReadMask(const std::string& path) const {
     const std::string bytes = internal::ReadWholeFile(path);
     const cv::Mat mask = ForegroundOf(DecodeImageBytes(bytes, path), IsJpeg(bytes));
     Require(mask.cols == camera_.width && mask.rows == camera_.height, path,
@@ -193,14 +179,12 @@ class MaskFolderSource : public FrameSource {
     return undistorter_.Apply(mask, cv::INTER_NEAREST);
   }
 
-  int num_frames() const override { return static_cast<int>(frame_names_.size()); }
-
- private:
   std::string folder_;
   ImageFolderIndex index_;
   std::vector<std::string> frame_names_;
   Camera camera_;
   Undistorter undistorter_;
+  Content content_;
 };
 
 // The video at `path` through the OpenCV extras (src/util/opencv_extras.h), which are loaded
@@ -268,14 +252,16 @@ std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
                                                    const std::vector<std::string>& frame_names,
                                                    const Camera& camera) {
   camera.Validate(folder);
-  return std::make_unique<ImageFolderSource>(folder, frame_names, camera);
+  return std::make_unique<ImageFolderSource>(folder, frame_names, camera,
+                                             ImageFolderSource::Content::kImages);
 }
 
 std::unique_ptr<FrameSource> MakeMaskFolderSource(const std::string& folder,
                                                   const std::vector<std::string>& frame_names,
                                                   const Camera& camera) {
   camera.Validate(folder);
-  return std::make_unique<MaskFolderSource>(folder, frame_names, camera);
+  return std::make_unique<ImageFolderSource>(folder, frame_names, camera,
+                                             ImageFolderSource::Content::kMasks);
 }
 
 std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,
