@@ -151,6 +151,12 @@ TEST_F(MaskedCaptureTest, HeldOutScoreIgnoresPixelsOutsideTheMasks) {
   }
   EXPECT_EQ(masked_repainted.mean[0].mad, masked.mean[0].mad);
   EXPECT_NE(plain_repainted.mean[0].mad, plain.mean[0].mad);
+
+  std::vector<CalibratedImage> badly_masked = held_out;
+  badly_masked[1].mask = cv::Mat::ones(10, 10, CV_8UC1);
+  testing_util::ExpectErrorMentions(
+      [&] { ScoreHeldOutViews(training, badly_masked, surfaces, HeldOutOptions()); },
+      {"held-out camera cam03", "the mask is not CV_8UC1 of the image's size"});
 }
 
 }  // namespace
