@@ -258,3 +258,75 @@ TEST(CaptureTest, NoMeshesAndBadMask) {
 
 }  // namespace
 }  // namespace finecap
+
+namespace finecap {
+namespace {
+
+// A mask whose left half is foreground, written as `foreground` (any non-zero value).
+cv::Mat LeftHalf(int foreground, int width = kWidth, int height = kHeight) {
+  cv::Mat mask = cv::Mat::zeros(height, width, CV_8UC1);
+  mask.colRange(0, width / 2).setTo(foreground);
+  return mask;
+}
+
+// MakeCapture with masks for both cameras in `folder` (masks or mask), as PNG or JPEG.
+std::string MakeMaskedCapture(const std::string& folder, const std::string& extension) {
+  const std::string dir = MakeCapture();
+  for (const std::string camera : {"cam0", "cam1"}) {
+    fs::create_directories(dir + "/" + folder + "/" + camera);
+    for (const std::string& frame : kFrames) {
+      // ZJU-MoCap's masks hold 1 on the subject; a JPEG's hold 255.
+      const cv::Mat mask = LeftHalf(extension == ".png" ? 1 : 255);
+      cv::imwrite(dir + "/" + folder + "/" + camera + "/" + frame + extension, mask);
+    }
+  }
+  return dir;
+}
+
+TEST(CaptureMaskTest, MasksAreReadUndistortedByTheNearestPixel) {
+  for (const auto& [folder, extension] :
+       std::vector<std::pair<std::string, std::string>>{{"masks", ".png"}, {"mask", ".jpg"}}) {
+    Capture capture = Capture::Open(MakeMaskedCapture(folder, extension));
+    ASSERT_TRUE(capture.has_masks()) << folder;
+    for (int camera = 0; camera < 2; ++camera) {
+      const cv::Mat mask = capture.ReadMask(camera, 3);
+      ASSERT_EQ(mask.type(), CV_8UC1);
+      EXPECT_EQ(mask.size(), cv::Size(kWidth, kHeight));
+      // Labels, not blends: nothing but 0 and 255, even where undistortion resampled.
+      EXPECT_EQ(cv::countNonZero((mask != 0) & (mask != 255)), 0) << folder << camera;
+      EXPECT_EQ(mask.at<unsigned char>(15, 5), 255) << folder << camera;
+      EXPECT_EQ(mask.at<unsigned char>(15, 35), 0) << folder << camera;
+    }
+  }
+}
+
+TEST(CaptureMaskTest, ACaptureWithoutMasksHasNone) {
+  Capture capture = Capture::Open(MakeCapture());
+  EXPECT_FALSE(capture.has_masks());
+  EXPECT_TRUE(capture.ReadMask(1, 2).empty());
+}
+
+TEST(CaptureMaskTest, BadMasksAreNamed) {
+  std::string dir = MakeMaskedCapture("masks", ".png");
+  fs::remove_all(dir + "/masks/cam1");
+  ExpectErrorMentions([&] { Capture::Open(dir); }, {dir + "/masks/cam1", "mask folder not found"});
+
+  dir = MakeMaskedCapture("masks", ".png");
+  cv::imwrite(dir + "/masks/cam0/0.png", LeftHalf(1, 20, 10));
+  ExpectErrorMentions(
+      [&] { Capture::Open(dir); },
+      {dir + "/masks/cam0/0.png", "the mask is 20x10 but camera cam0's images are 40x30"});
+
+  dir = MakeMaskedCapture("masks", ".png");
+  cv::imwrite(dir + "/masks/cam1/2.png", LeftHalf(1, 20, 10));
+  WriteText(dir + "/masks/cam0/2.png", "not an image");
+  fs::remove(dir + "/masks/cam0/10.png");
+  Capture capture = Capture::Open(dir);  // Only the first masks are checked up front.
+  ExpectErrorMentions([&] { capture.ReadMask(0, 2); }, {dir + "/masks/cam0/2.png", "decode"});
+  ExpectErrorMentions([&] { capture.ReadMask(1, 2); }, {dir + "/masks/cam1/2.png", "20x10"});
+  ExpectErrorMentions([&] { capture.ReadMask(0, 3); },
+                      {dir + "/masks/cam0", "no image for frame '10'"});
+}
+
+}  // namespace
+}  // namespace finecap

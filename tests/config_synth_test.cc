@@ -206,7 +206,7 @@ TEST(ConfigSynthTest, HelpListsEverySynthKeyOnceWithADoc) {
   Config config;
   const std::string help = MakeConfigSchema(&config).HelpText("synth.");
   const std::vector<std::string> listed = HelpPaths(help);
-  EXPECT_EQ(listed.size(), 52u) << help;
+  EXPECT_EQ(listed.size(), 54u) << help;
   EXPECT_EQ(std::set<std::string>(listed.begin(), listed.end()).size(), listed.size()) << help;
   for (const char* key : {"synth.folds", "synth.seed", "synth.cameras.distortion",
                           "synth.render.noise_seed", "synth.texture.textureless_color"}) {
@@ -268,7 +268,7 @@ TEST(ConfigSynthTest, EveryValuePrintsAsYamlThatReadsBackUnchanged) {
   Config reread;
   ConfigSchema reader = MakeConfigSchema(&reread);
   const std::vector<std::string> keys = HelpPaths(printer.HelpText("synth."));
-  ASSERT_EQ(keys.size(), 52u);
+  ASSERT_EQ(keys.size(), 54u);
   for (const std::string& key : keys) reader.Set(key, printer.ValueText(key), "test");
 
   const SynthOptions& expected = noisy.synth;

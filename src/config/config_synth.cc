@@ -353,6 +353,11 @@ void AddSynthKeys(SynthOptions* options, ConfigSchema* schema) {
   AddTextureKeys(&options->texture, schema);
   AddRigKeys(&options->cameras, schema);
   AddRenderKeys(&options->render, schema);
+  schema->AddEnum("synth.background", &options->background,
+                  "Around the subject: plain (synth.render.background) or per_camera (a "
+                  "textured wall of its own in every camera).");
+  schema->AddBool("synth.write_masks", &options->write_masks,
+                  "Write the subject's silhouettes as foreground masks (masks/<camera>/).");
   AddSeed(schema, "synth.seed", &options->seed,
           "Seed of every random choice (texture, misalignment, calibration and sensor noise).");
 }

@@ -57,6 +57,15 @@ std::vector<fs::path> ColmapMeshes(const fs::path& dir) {
   return meshes;
 }
 
+// The folder of foreground masks: masks/, else mask/ (ZJU-MoCap, EasyMocap); empty if neither.
+std::string FindMaskFolder(const fs::path& dir) {
+  std::error_code error;
+  for (const char* name : {"masks", "mask"}) {
+    if (fs::is_directory(dir / name, error)) return (dir / name).string();
+  }
+  return "";
+}
+
 Eigen::VectorXd ParseDisplacements(const std::string& path, int num_vertices) {
   std::istringstream stream(internal::ReadWholeFile(path));
   std::vector<double> values;
@@ -108,6 +117,7 @@ Capture Capture::Open(const std::string& dir, const std::string& mesh) {
   capture.FindFrames(mesh);
   capture.ReadCameras(rig.colmap_images);
   capture.OpenFrameSources();
+  capture.OpenMaskSources();
   capture.ReadOptionalFiles();
   return capture;
 }
@@ -207,6 +217,20 @@ void Capture::OpenFrameSources() {
               [this](int c) { first_images_[c] = sources_[c]->Read(0); });
 }
 
+void Capture::OpenMaskSources() {
+  const std::string folder = FindMaskFolder(directory_);
+  if (folder.empty()) return;
+  for (const Camera& camera : rig_) {
+    const fs::path camera_folder = fs::path(folder) / camera.name;
+    std::error_code error;
+    Require(fs::is_directory(camera_folder, error), camera_folder.string(),
+            "mask folder not found: with " + folder + " every camera needs its masks");
+    mask_sources_.push_back(MakeMaskFolderSource(camera_folder.string(), frame_names_, camera));
+  }
+  // Checks the first mask of each camera, as the first images are checked.
+  ParallelFor(static_cast<int>(mask_sources_.size()), [this](int c) { mask_sources_[c]->Read(0); });
+}
+
 void Capture::ReadOptionalFiles() {
   const fs::path dir(directory_);
   std::error_code error;
@@ -245,10 +269,14 @@ Mesh Capture::ReadCoarseMesh(int frame) const {
   return mesh;
 }
 
-cv::Mat Capture::ReadImage(int camera_index, int frame) {
+void Capture::RequireCamera(int camera_index) const {
   Require(camera_index >= 0 && camera_index < num_cameras(), directory_,
           "camera index " + std::to_string(camera_index) + " is outside [0, " +
               std::to_string(num_cameras()) + ")");
+}
+
+cv::Mat Capture::ReadImage(int camera_index, int frame) {
+  RequireCamera(camera_index);
   RequireFrame(frame);
   cv::Mat& first = first_images_[camera_index];
   if (!first.empty()) {
@@ -256,6 +284,13 @@ cv::Mat Capture::ReadImage(int camera_index, int frame) {
     first.release();
   }
   return sources_[camera_index]->Read(frame);
+}
+
+cv::Mat Capture::ReadMask(int camera_index, int frame) {
+  RequireCamera(camera_index);
+  RequireFrame(frame);
+  if (!has_masks()) return cv::Mat();
+  return mask_sources_[camera_index]->Read(frame);
 }
 
 std::string Capture::GroundTruthPath(int frame, const std::string& suffix) const {

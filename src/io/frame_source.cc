@@ -38,19 +38,33 @@ bool JpegHasEndMarker(const std::string& bytes) {
 
 bool IsJpeg(const std::string& bytes) { return bytes.compare(0, 2, "\xFF\xD8") == 0; }
 
-// Decodes an image file to 8-bit BGR, refusing empty, truncated and undecodable files.
-cv::Mat DecodeImageFile(const std::string& path) {
-  const std::string bytes = internal::ReadWholeFile(path);
+// Decodes the bytes of the image file `path` to 8-bit BGR, refusing empty, truncated and
+// undecodable files.
+cv::Mat DecodeImageBytes(const std::string& bytes, const std::string& path) {
   Require(!bytes.empty(), path, "the image file is empty (0 bytes)");
   Require(!IsJpeg(bytes) || JpegHasEndMarker(bytes), path,
           "the JPEG image is truncated (no end marker)");
   return internal::DecodeImage(bytes, path);
 }
 
+cv::Mat DecodeImageFile(const std::string& path) {
+  return DecodeImageBytes(internal::ReadWholeFile(path), path);
+}
+
 bool IsImageExtension(std::string extension) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
+}
+
+// A decoded mask as 0 (background) and 255 (foreground). A PNG stores labels exactly, so any
+// non-zero value is foreground (ZJU-MoCap's masks are 0 and 1); a JPEG's compression leaves
+// small non-zero values in the background, so there foreground is above half the range.
+cv::Mat ForegroundOf(const cv::Mat& bgr, bool lossy) {
+  cv::Mat channels[3], brightest;
+  cv::split(bgr, channels);
+  brightest = cv::max(cv::max(channels[0], channels[1]), channels[2]);
+  return brightest > (lossy ? 127 : 0);
 }
 
 // The images of a folder, found by frame name: listed once so that a frame costs no directory
@@ -112,10 +126,12 @@ class Undistorter {
     cv::convertMaps(map_x, map_y, map1_, map2_, CV_16SC2);
   }
 
-  cv::Mat Apply(const cv::Mat& image) const {
+  // `interpolation`: cv::INTER_LINEAR for images, cv::INTER_NEAREST for masks (whose values
+  // are labels, not intensities).
+  cv::Mat Apply(const cv::Mat& image, int interpolation = cv::INTER_LINEAR) const {
     if (map1_.empty()) return image;
     cv::Mat undistorted;
-    cv::remap(image, undistorted, map1_, map2_, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    cv::remap(image, undistorted, map1_, map2_, interpolation, cv::BORDER_CONSTANT);
     return undistorted;
   }
 
@@ -128,19 +144,24 @@ void RequireFrameInRange(int frame, int num_frames, const std::string& where) {
           "frame " + std::to_string(frame) + " is outside [0, " + std::to_string(num_frames) + ")");
 }
 
+// The images of a folder, or its masks (ForegroundOf), one frame at a time.
 class ImageFolderSource : public FrameSource {
  public:
+  enum class Content { kImages, kMasks };
+
   ImageFolderSource(const std::string& folder, const std::vector<std::string>& frame_names,
-                    const Camera& camera)
+                    const Camera& camera, Content content)
       : folder_(folder),
         index_(folder),
         frame_names_(frame_names),
         camera_(camera),
-        undistorter_(camera) {}
+        undistorter_(camera),
+        content_(content) {}
 
   cv::Mat Read(int frame) override {
     RequireFrameInRange(frame, num_frames(), folder_);
     const std::string path = index_.Find(frame_names_[frame]);
+    if (content_ == Content::kMasks) return ReadMask(path);
     const cv::Mat image = DecodeImageFile(path);
     RequireCameraSize(image, camera_, path);
     return undistorter_.Apply(image);
@@ -149,11 +170,21 @@ class ImageFolderSource : public FrameSource {
   int num_frames() const override { return static_cast<int>(frame_names_.size()); }
 
  private:
+  cv::Mat ReadMask(const std::string& path) const {
+    const std::string bytes = internal::ReadWholeFile(path);
+    const cv::Mat mask = ForegroundOf(DecodeImageBytes(bytes, path), IsJpeg(bytes));
+    Require(mask.cols == camera_.width && mask.rows == camera_.height, path,
+            "the mask is " + SizeText(mask.cols, mask.rows) + " but camera " + camera_.name +
+                "'s images are " + SizeText(camera_.width, camera_.height));
+    return undistorter_.Apply(mask, cv::INTER_NEAREST);
+  }
+
   std::string folder_;
   ImageFolderIndex index_;
   std::vector<std::string> frame_names_;
   Camera camera_;
   Undistorter undistorter_;
+  Content content_;
 };
 
 // One image file, the only frame: COLMAP's flat images/NAME layout.
@@ -247,7 +278,16 @@ std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
                                                    const std::vector<std::string>& frame_names,
                                                    const Camera& camera) {
   camera.Validate(folder);
-  return std::make_unique<ImageFolderSource>(folder, frame_names, camera);
+  return std::make_unique<ImageFolderSource>(folder, frame_names, camera,
+                                             ImageFolderSource::Content::kImages);
+}
+
+std::unique_ptr<FrameSource> MakeMaskFolderSource(const std::string& folder,
+                                                  const std::vector<std::string>& frame_names,
+                                                  const Camera& camera) {
+  camera.Validate(folder);
+  return std::make_unique<ImageFolderSource>(folder, frame_names, camera,
+                                             ImageFolderSource::Content::kMasks);
 }
 
 std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,

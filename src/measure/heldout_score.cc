@@ -34,6 +34,9 @@ void CheckView(const CalibratedImage& view, const std::string& role) {
   Require(view.image.type() == CV_8UC3 && view.image.cols == view.camera.width &&
               view.image.rows == view.camera.height,
           where, "the image is not 8-bit BGR of the camera's size");
+  Require(
+      view.mask.empty() || (view.mask.type() == CV_8UC1 && view.mask.size() == view.image.size()),
+      where, "the mask is not CV_8UC1 of the image's size");
 }
 
 cv::Mat GreyLevels(const cv::Mat& bgr) {
@@ -68,6 +71,15 @@ cv::Vec3b SampleColor(const cv::Mat& image, double u, double v) {
     color[ch] = cv::saturate_cast<unsigned char>(value);
   }
   return color;
+}
+
+// Whether every pixel a bilinear read at (u, v), inside the image, blends is on the foreground
+// of `mask`: what is read there then owes nothing to the background.
+bool ReadsForegroundOnly(const cv::Mat& mask, double u, double v) {
+  const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+  const int x1 = std::min(x0 + 1, mask.cols - 1), y1 = std::min(y0 + 1, mask.rows - 1);
+  return mask.at<unsigned char>(y0, x0) != 0 && mask.at<unsigned char>(y0, x1) != 0 &&
+         mask.at<unsigned char>(y1, x0) != 0 && mask.at<unsigned char>(y1, x1) != 0;
 }
 
 // One training view warped into a held-out view through one surface.
@@ -105,6 +117,7 @@ Warp WarpThroughSurface(const Camera& target, const DepthMap& target_depth,
       const int nearest_y = static_cast<int>(std::lround(v));
       const float seen = source_depth.depth.at<float>(nearest_y, nearest_x);
       if (!std::isfinite(seen) || in_source.z() > seen + tolerance * in_source.z()) continue;
+      if (!source.mask.empty() && !ReadsForegroundOnly(source.mask, u, v)) continue;
       warp.valid.at<unsigned char>(y, x) = 255;
       warp.grey.at<float>(y, x) = SampleGrey(source_grey, u, v);
       if (with_color) warp.color.at<cv::Vec3b>(y, x) = SampleColor(source.image, u, v);
@@ -360,6 +373,7 @@ HeldOutViewScore ScoreView(const CalibratedImage& held_out,
     target.depths.push_back(RenderDepth(held_out.camera, *surface));
     target.covered &= target.depths.back().triangle_ids >= 0;
   }
+  if (!held_out.mask.empty()) target.covered &= held_out.mask != 0;
   std::vector<Camera> training_cameras;
   for (const CalibratedImage& view : training) training_cameras.push_back(view.camera);
   HeldOutViewScore score;

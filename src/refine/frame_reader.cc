@@ -52,14 +52,18 @@ FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
   // Each camera's images come from a source of its own, so they are decoded side by side; the
   // failures are then taken in the rig's order, as one camera after the other would meet them.
   const int num_cameras = capture->num_cameras();
-  std::vector<cv::Mat> images(num_cameras);
-  const std::vector<std::exception_ptr> failures = ParallelForKeepingFailures(
-      num_cameras, [&](int c) { images[c] = capture->ReadImage(c, frame); });
+  std::vector<cv::Mat> images(num_cameras), masks(num_cameras);
+  const std::vector<std::exception_ptr> failures =
+      ParallelForKeepingFailures(num_cameras, [&](int c) {
+        images[c] = capture->ReadImage(c, frame);
+        masks[c] = capture->ReadMask(c, frame);
+      });
   std::string first_error;
   for (int c = 0; c < num_cameras; ++c) {
     const Camera& camera = capture->cameras()[c];
     if (!failures[c]) {
       input.images.push_back(std::move(images[c]));
+      if (capture->has_masks()) input.masks.push_back(std::move(masks[c]));
       input.cameras.push_back(camera);
       continue;
     }
@@ -79,15 +83,18 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
                                               FrameInput* input) {
   std::vector<CalibratedImage> views;
   const bool modelled = input->image_models.size() == input->images.size();
+  const bool masked = !input->masks.empty();
   FrameInput training;
   training.coarse = std::move(input->coarse);
   for (size_t c = 0; c < input->cameras.size(); ++c) {
     const std::string& name = input->cameras[c].name;
+    const cv::Mat mask = masked ? input->masks[c] : cv::Mat();
     if (std::find(held_out.begin(), held_out.end(), name) != held_out.end()) {
-      views.push_back({input->cameras[c], input->images[c]});
+      views.push_back({input->cameras[c], input->images[c], mask});
     } else {
       training.cameras.push_back(input->cameras[c]);
       training.images.push_back(input->images[c]);
+      if (masked) training.masks.push_back(mask);
       if (modelled) training.image_models.push_back(std::move(input->image_models[c]));
     }
   }
@@ -101,7 +108,8 @@ std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& he
 std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input) {
   std::vector<CalibratedImage> views;
   for (size_t c = 0; c < input.cameras.size(); ++c) {
-    views.push_back({input.cameras[c], input.images[c]});
+    views.push_back(
+        {input.cameras[c], input.images[c], input.masks.empty() ? cv::Mat() : input.masks[c]});
   }
   return views;
 }

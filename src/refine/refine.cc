@@ -9,6 +9,7 @@
 #include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/render.h"
 #include "finecap/util/error.h"
+#include "refine/foreground.h"
 #include "refine/surface_sampling.h"
 
 namespace finecap {
@@ -40,6 +41,13 @@ bool UsesSurfaceSamples(const RefineOptions& options) {
          options.energy.consensus.sample_spacing > 0.0;
 }
 
+// Pixels about a surface sample (at its nearest pixel) that its reads take colour from: the
+// bilinear read's next pixel and the blur's reach (two standard deviations), so that a sample
+// kept on the shrunk mask does not read the black painted on the background.
+int SampleReach(const ConsensusOptions& consensus) {
+  return 1 + static_cast<int>(std::ceil(2.0 * consensus.sample_blur));
+}
+
 // The energy's options with the patch's rings counted on the refined mesh (PatchRingsAt).
 EnergyOptions EnergyOptionsAt(const RefineOptions& options) {
   EnergyOptions energy = options.energy;
@@ -66,7 +74,7 @@ std::vector<ImageGaussians> BuildImageModels(const FrameInput& input,
                                              const ImageGaussianOptions& options) {
   std::vector<std::string> names;
   for (const Camera& camera : input.cameras) names.push_back(camera.name);
-  return BuildFrameImageGaussians(input.images, {}, options, names);
+  return BuildFrameImageGaussians(input.images, input.masks, options, names);
 }
 
 }  // namespace
@@ -111,11 +119,15 @@ Mesh SequenceModel::Interpolate(const Mesh& coarse) const {
 std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
                                                                const Eigen::Matrix3Xd& normals,
                                                                const std::vector<Camera>& cameras,
-                                                               const VisibilityOptions& options) {
+                                                               const VisibilityOptions& options,
+                                                               const std::vector<cv::Mat>& masks) {
+  Require(masks.empty() || masks.size() == cameras.size(), "ComputeFrameVisibility",
+          "one mask per camera, or none, expected");
   std::vector<std::vector<unsigned char>> visible(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     const DepthMap depth = RenderDepth(cameras[c], mesh);
     visible[c] = ComputeVisibility(cameras[c], depth.depth, mesh.vertices, normals, options);
+    if (!masks.empty()) KeepForeground(cameras[c], masks[c], mesh.vertices, 0, &visible[c]);
   }
   return visible;
 }
@@ -129,15 +141,16 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
                                      const RefineOptions& options) {
   options.Check();
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility);
+  const auto visible =
+      ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility, frame.masks);
   if (options.reference_colors == ReferenceColorSource::kImageModel) {
     const std::vector<ImageGaussians> images = FrameImageModels(frame, options.image);
     return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
                                        options.sigma_hat, options.energy.overlap,
                                        options.energy.reach_sigmas);
   }
-  return ComputeReferenceColors(fine.vertices, normals, frame.cameras, frame.images, visible,
-                                options.image.color_space, options.sigma_hat);
+  return ComputeReferenceColors(fine.vertices, normals, frame.cameras, ForegroundImages(frame),
+                                visible, options.image.color_space, options.sigma_hat);
 }
 
 namespace {
@@ -152,8 +165,8 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
   frame.normals = ComputeVertexNormals(frame.fine);
-  frame.visible =
-      ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility);
+  frame.visible = ComputeFrameVisibility(frame.fine, frame.normals, input.cameras,
+                                         options.visibility, input.masks);
   const auto& visible = frame.visible;
   frame.images = std::move(images);
 
@@ -221,6 +234,10 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     cameras[c].camera = input.cameras[c];
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
     cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
+    if (!input.masks.empty()) {
+      KeepForeground(input.cameras[c], input.masks[c], samples.base, SampleReach(consensus),
+                     &cameras[c].samples_visible);
+    }
     cameras[c].pixels = pixels[c];
   }
   frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),

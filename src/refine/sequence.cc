@@ -392,7 +392,10 @@ class SequenceRun {
       read->prepared = PrepareFrameAhead(model_, reference_colors_, &read->input, options_.refine);
       // Beside the refinement only the held-out score reads the pixels after this: two frames'
       // images are a run's largest buffers.
-      if (DropsImagesAhead()) read->input.images.clear();
+      if (DropsImagesAhead()) {
+        read->input.images.clear();
+        read->input.masks.clear();
+      }
     }
   }
 

@@ -7,6 +7,7 @@
 
 #include "finecap/geometry/color.h"
 #include "finecap/geometry/subdivision.h"
+#include "refine/foreground.h"
 #include "refine/scene_scale.h"
 
 namespace finecap {
@@ -81,9 +82,9 @@ std::vector<unsigned char> SampleVisibility(const SurfaceSamples& samples,
 }
 
 std::vector<cv::Mat> SampledImages(const FrameInput& input, ColorSpace space, double blur) {
-  std::vector<cv::Mat> images(input.images.size());
+  std::vector<cv::Mat> images = ForegroundImages(input);
   for (size_t c = 0; c < images.size(); ++c) {
-    images[c] = ConvertImage(input.images[c], space, input.cameras[c].name);
+    images[c] = ConvertImage(images[c], space, input.cameras[c].name);
     if (blur > 0.0) cv::GaussianBlur(images[c], images[c], cv::Size(0, 0), blur);
   }
   return images;

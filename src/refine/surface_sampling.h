@@ -39,7 +39,8 @@ std::vector<unsigned char> SampleVisibility(const SurfaceSamples& samples,
                                             const std::vector<unsigned char>& surface_visible);
 
 // Each camera's image in `space`, blurred by a Gaussian of `blur` pixels (none when 0), as the
-// samples read it (CameraInput::pixels).
+// samples read it (CameraInput::pixels); with masks, its background black before the blur
+// (ForegroundImages).
 std::vector<cv::Mat> SampledImages(const FrameInput& input, ColorSpace space, double blur);
 
 }  // namespace finecap

@@ -35,7 +35,12 @@ std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t stream) {
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
   return z ^ (z >> 31);
 }
-enum SeedStream : std::uint64_t { kTextureStream = 1, kMisalignmentStream, kCalibrationStream };
+enum SeedStream : std::uint64_t {
+  kTextureStream = 1,
+  kMisalignmentStream,
+  kCalibrationStream,
+  kBackgroundStream,  // The first of one stream per camera.
+};
 
 std::string FrameName(int frame) {
   char name[16];
@@ -187,6 +192,70 @@ DistortionMap MakeDistortionMap(const Camera& camera) {
   return map;
 }
 
+// A camera's own background wall: random colours at two scales (blotches of about a sixth of
+// the image and a texture of ~6 px), so that it is textured where the silhouette meets it and
+// differs from every other camera's.
+cv::Mat MakeCameraBackground(int width, int height, std::uint64_t seed) {
+  cv::RNG rng(seed);
+  const auto noise = [&](int cell, double low, double high) {
+    cv::Mat coarse(std::max(2, height / cell), std::max(2, width / cell), CV_32FC3), fine;
+    rng.fill(coarse, cv::RNG::UNIFORM, cv::Scalar::all(low), cv::Scalar::all(high));
+    cv::resize(coarse, fine, cv::Size(width, height), 0, 0, cv::INTER_CUBIC);
+    return fine;
+  };
+  const cv::Mat wall = noise(160, 40.0, 200.0) + noise(6, -50.0, 50.0);
+  cv::Mat background;
+  wall.convertTo(background, CV_8UC3);
+  return background;
+}
+
+// What `lens` records of `mesh`: rendered straight, or, with lens distortion (`distortion`
+// its map), rendered undistorted on the map's enlarged canvas and distorted.
+cv::Mat Record(const Camera& lens, const DistortionMap* distortion, const Mesh& mesh,
+               const SurfaceAppearance& appearance, const RenderOptions& render) {
+  if (distortion == nullptr) return RenderColor(lens, mesh, appearance, render);
+  Camera canvas = lens.Undistorted();
+  canvas.width += 2 * distortion->pad;
+  canvas.height += 2 * distortion->pad;
+  canvas.K(0, 2) += distortion->pad;
+  canvas.K(1, 2) += distortion->pad;
+  const cv::Mat undistorted = RenderColor(canvas, mesh, appearance, render);
+  const Eigen::Vector3d background = 255.0 * render.background;
+  cv::Mat image;
+  cv::remap(undistorted, image, distortion->map_x, distortion->map_y, cv::INTER_LINEAR,
+            cv::BORDER_CONSTANT, cv::Scalar(background.z(), background.y(), background.x()));
+  return image;
+}
+
+// The part of each pixel of what `lens` records that `mesh` covers, 0-255 (CV_8UC1): the mesh
+// recorded in white on black, anti-aliased as the images are.
+cv::Mat RecordCoverage(const Camera& lens, const DistortionMap* distortion, const Mesh& mesh,
+                       const RenderOptions& render) {
+  RenderOptions flat = render;
+  flat.shade = false;
+  flat.background = Eigen::Vector3d::Zero();
+  SurfaceAppearance white;
+  white.vertex_colors = Eigen::Matrix3Xd::Ones(3, mesh.num_vertices());
+  cv::Mat channels[3];
+  cv::split(Record(lens, distortion, mesh, white, flat), channels);
+  return channels[0];
+}
+
+// Replaces the plain background `plain` (BGR, 0-255) of `image` by `wall`, pixel by pixel in
+// proportion to the part of the pixel the subject leaves uncovered.
+void PutOnWall(const cv::Mat& coverage, const cv::Mat& wall, const cv::Scalar& plain,
+               cv::Mat* image) {
+  cv::Mat uncovered, change, result;
+  coverage.convertTo(uncovered, CV_32F, -1.0 / 255.0, 1.0);
+  wall.convertTo(change, CV_32FC3);
+  change -= plain;
+  cv::Mat uncovered3;
+  cv::merge(std::vector<cv::Mat>(3, uncovered), uncovered3);
+  image->convertTo(result, CV_32FC3);
+  result += change.mul(uncovered3);
+  result.convertTo(*image, CV_8UC3);
+}
+
 void RequireEmptyFolder(const std::string& out_dir) {
   namespace fs = std::filesystem;
   Require(!out_dir.empty(), "synth output", "no output folder given");
@@ -299,7 +368,8 @@ SyntheticFrame SyntheticCapture::Frame(int index) const {
   return frame;
 }
 
-cv::Mat SyntheticCapture::Image(const SyntheticFrame& frame, int index, int camera) const {
+cv::Mat SyntheticCapture::Image(const SyntheticFrame& frame, int index, int camera,
+                                cv::Mat* mask) const {
   const Impl& impl = *impl_;
   Require(camera >= 0 && camera < static_cast<int>(impl.true_cameras.size()), "synthetic capture",
           "camera " + std::to_string(camera) + " does not exist");
@@ -308,21 +378,20 @@ cv::Mat SyntheticCapture::Image(const SyntheticFrame& frame, int index, int came
       MixSeed(impl.options.seed ^ MixSeed(render.noise_seed, 0),
               1000 + static_cast<std::uint64_t>(index) * impl.true_cameras.size() + camera);
   render.noise_sigma = 0.0;  // Noise is added at the sensor, after the lens.
-  const Camera& truth = impl.true_cameras[camera];
-  cv::Mat image;
-  if (!truth.HasDistortion()) {
-    image = RenderColor(truth, frame.truth, impl.appearance, render);
-  } else {
-    const DistortionMap& map = impl.distortion_maps[camera];
-    Camera canvas = truth.Undistorted();
-    canvas.width += 2 * map.pad;
-    canvas.height += 2 * map.pad;
-    canvas.K(0, 2) += map.pad;
-    canvas.K(1, 2) += map.pad;
-    const cv::Mat undistorted = RenderColor(canvas, frame.truth, impl.appearance, render);
-    const Eigen::Vector3d background = 255.0 * render.background;
-    cv::remap(undistorted, image, map.map_x, map.map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-              cv::Scalar(background.z(), background.y(), background.x()));
+  const Camera& lens = impl.true_cameras[camera];
+  const DistortionMap* distortion = lens.HasDistortion() ? &impl.distortion_maps[camera] : nullptr;
+  cv::Mat image = Record(lens, distortion, frame.truth, impl.appearance, render);
+  const bool on_wall = impl.options.background == SynthBackground::kPerCamera;
+  if (on_wall || mask != nullptr) {
+    const cv::Mat coverage = RecordCoverage(lens, distortion, frame.truth, render);
+    if (on_wall) {
+      const Eigen::Vector3d plain = 255.0 * render.background;
+      PutOnWall(coverage,
+                MakeCameraBackground(lens.width, lens.height,
+                                     MixSeed(impl.options.seed, kBackgroundStream + camera)),
+                cv::Scalar(plain.z(), plain.y(), plain.x()), &image);
+    }
+    if (mask != nullptr) *mask = coverage >= 128;
   }
   AddSensorNoise(impl.options.render.noise_sigma, noise_seed, &image);
   return image;
@@ -336,6 +405,7 @@ void GenerateSyntheticCapture(const SynthOptions& options, const std::string& ou
   const fs::path root(out_dir);
   for (const Camera& camera : capture.true_cameras()) {
     fs::create_directories(root / "images" / camera.name);
+    if (options.write_masks) fs::create_directories(root / "masks" / camera.name);
   }
   fs::create_directories(root / "meshes");
   fs::create_directories(root / "gt");
@@ -351,8 +421,12 @@ void GenerateSyntheticCapture(const SynthOptions& options, const std::string& ou
                             DisplacementText(frame.true_k));
     for (int c = 0; c < static_cast<int>(capture.true_cameras().size()); ++c) {
       const std::string camera = capture.true_cameras()[c].name;
+      cv::Mat mask;
       internal::WritePng((root / "images" / camera / (name + ".png")).string(),
-                         capture.Image(frame, index, c));
+                         capture.Image(frame, index, c, options.write_masks ? &mask : nullptr));
+      if (options.write_masks) {
+        internal::WritePng((root / "masks" / camera / (name + ".png")).string(), mask);
+      }
     }
   }
 }

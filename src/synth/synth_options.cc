@@ -47,6 +47,12 @@ const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput) {
   return names;
 }
 
+const std::vector<EnumName<SynthBackground>>& EnumNames(SynthBackground) {
+  static const std::vector<EnumName<SynthBackground>> names = {
+      {SynthBackground::kPlain, "plain"}, {SynthBackground::kPerCamera, "per_camera"}};
+  return names;
+}
+
 void TaubinSmoothingOptions::Check(const std::string& where) const {
   Require(iterations >= 1 && iterations <= 100000, where + ".iterations",
           "is " + std::to_string(iterations) + " but must lie in [1, 100000]");
@@ -128,6 +134,7 @@ void SynthOptions::Check() const {
   const std::string where = "SynthOptions::";
   internal::RequireKnownChoice(subject, where + "subject");
   internal::RequireKnownChoice(coarse, where + "coarse");
+  internal::RequireKnownChoice(background, where + "background");
   if (subject == SynthSubject::kSkirt) skirt.Check();
   if (subject == SynthSubject::kMesh) {
     Require(!mesh_path.empty(), where + "mesh_path", "must name a mesh file or folder");

@@ -5,6 +5,10 @@
 //     cameras.yaml (or intri.yml + extri.yml, a Calib.toml, or a COLMAP model; see camera_io.h)
 //     images/<camera>/<frame>.png|.jpg|.jpeg   or   videos/<camera>.<ext>
 //     meshes/<frame>.<ply|obj|off|...>          coarse mesh per frame, one topology
+//     masks/<camera>/<frame>.png|.jpg|.jpeg     optional: foreground masks, non-zero on the
+//                                               subject (or mask/<camera>/..., the layout of
+//                                               ZJU-MoCap and EasyMocap); every camera has one
+//                                               per frame
 //     mask.txt                                  optional: vertex ids to refine (vertex_mask.h)
 //     gt/<frame>.ply                            optional: the true (fine) surface of that frame
 //     gt/<frame>_k.txt                          optional: per coarse vertex, the true displacement
@@ -43,11 +47,12 @@ class Capture {
   // exists; the rig reads and every camera is valid (an intri/extri rig without image sizes gets
   // them from each camera's first image); there is at least one mesh and the first one is a valid
   // mesh; every camera has images/<camera>/ or videos/<camera>.* (or, from a COLMAP model, the
-  // image it names); the first image of every camera decodes and has the camera's size; mask.txt
-  // and gt/textureless.txt, when present, hold valid ids. Later frames are checked when read.
-  // Throws Error naming the file and the problem. `mesh`, when not empty, is the coarse mesh of a
-  // one-frame capture, named after its stem, instead of meshes/ or a meshed-*.ply (a relative path
-  // is from the working directory).
+  // image it names); the first image of every camera decodes and has the camera's size; with a
+  // masks/ (or mask/) folder, every camera has a folder there and its first mask decodes and has
+  // the camera's size; mask.txt and gt/textureless.txt, when present, hold valid ids. Later frames
+  // are checked when read. Throws Error naming the file and the problem. `mesh`, when not empty,
+  // is the coarse mesh of a one-frame capture, named after its stem, instead of meshes/ or a
+  // meshed-*.ply (a relative path is from the working directory).
   static Capture Open(const std::string& dir, const std::string& mesh = "");
 
   Capture(Capture&&) = default;
@@ -80,6 +85,13 @@ class Capture {
   // threads is safe; reading one camera from two threads is not.
   cv::Mat ReadImage(int camera_index, int frame);
 
+  // Whether the capture has foreground masks (masks/ or mask/).
+  bool has_masks() const { return !mask_sources_.empty(); }
+  // The undistorted foreground mask of camera `camera_index` at `frame`: CV_8UC1 of the camera's
+  // size, 255 on the subject and 0 on the background (MakeMaskFolderSource); empty when the
+  // capture has no masks. Thread safety as ReadImage's.
+  cv::Mat ReadMask(int camera_index, int frame);
+
   // The sorted vertex ids of mask.txt; empty when the capture has no mask (refine every vertex).
   const std::vector<int>& vertex_mask() const { return vertex_mask_; }
   bool has_vertex_mask() const { return has_vertex_mask_; }
@@ -106,6 +118,8 @@ class Capture {
   void FindColmapMesh();
   std::string FindCameraStream(const Camera& camera, const std::string& colmap_image) const;
   void OpenFrameSources();
+  void OpenMaskSources();
+  void RequireCamera(int camera_index) const;
   void ReadOptionalFiles();
   void RequireFrame(int frame) const;
   std::string GroundTruthPath(int frame, const std::string& suffix) const;
@@ -123,6 +137,7 @@ class Capture {
   // ReadImage of that frame takes it instead of decoding it again, and a read of any other frame
   // drops it.
   std::vector<cv::Mat> first_images_;
+  std::vector<std::unique_ptr<FrameSource>> mask_sources_;  // Empty without masks.
   std::vector<int> vertex_mask_;
   bool has_vertex_mask_ = false;
   bool has_ground_truth_ = false;

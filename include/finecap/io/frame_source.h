@@ -39,6 +39,16 @@ std::unique_ptr<FrameSource> MakeImageFolderSource(const std::string& folder,
                                                    const std::vector<std::string>& frame_names,
                                                    const Camera& camera);
 
+// The foreground masks of one camera, found as MakeImageFolderSource finds images: Read returns
+// CV_8UC1, 255 on the foreground and 0 on the background, of the camera's size and undistorted
+// like its images but by the nearest pixel (a mask's values are labels, not to be blended). A PNG
+// pixel is foreground when any of its channels is non-zero; a JPEG's (whose compression leaves
+// faint values in the background) when one is above 127. Read throws Error naming the file when
+// it is missing, unreadable, or not of the camera's size.
+std::unique_ptr<FrameSource> MakeMaskFolderSource(const std::string& folder,
+                                                  const std::vector<std::string>& frame_names,
+                                                  const Camera& camera);
+
 // Frame i is the i-th frame of the video at `path` (anything cv::VideoCapture opens), for
 // `num_frames` frames. OpenCV's video input is loaded here, on the first video opened, from
 // libfinecap_opencv_extras.so; Error names that library when it cannot be loaded. Frames asked in

@@ -11,6 +11,10 @@
 //      it lies inside t's image and is not occluded there (its depth in t is at most
 //      depth_tolerance_px pixel footprints behind the surface's own depth map of t at the nearest
 //      pixel), and t's image is sampled bilinearly there.
+//      With masks, only the subject is scored: a held-out pixel on its view's background is not
+//      measured, nor is a surface point whose bilinear read in t blends a pixel of t's
+//      background (the
+//      backgrounds of different cameras need not agree, and are not what the surfaces explain).
 //   3. Scores are measured over the pixels that *every* surface passed to (covered in h and
 //      visible in t for each surface), so that all surfaces are scored on the same pixels:
 //        * NCC: local normalised cross-correlation of grey levels in window x window squares,
@@ -58,10 +62,12 @@ struct HeldOutOptions {
   void Check() const;
 };
 
-// One view: a pinhole camera (distortion zero) and its 8-bit BGR image of its size.
+// One view: a pinhole camera (distortion zero), its 8-bit BGR image of its size and, optionally,
+// its foreground mask (CV_8UC1 of the same size, zero on the background; empty: all foreground).
 struct CalibratedImage {
   Camera camera;
   cv::Mat image;
+  cv::Mat mask{};  // Initialised, so that {camera, image} needs no third member.
 };
 
 // The figures of one surface in one held-out view (or pooled over views). NaN when nothing was
@@ -95,8 +101,8 @@ struct HeldOutScore {
 // Scores every surface of `surfaces` (meshes of any topology; e.g. the input and the refined
 // mesh) in every view of `held_out`, warping the views of `training` in as described above.
 // When `maps` is given it receives one HeldOutViewMaps per held-out view. Throws Error when
-// `training` or `surfaces` is empty, an image is not 8-bit BGR of its camera's size, or the options
-// are invalid.
+// `training` or `surfaces` is empty, an image is not 8-bit BGR of its camera's size, a mask is
+// neither empty nor CV_8UC1 of that size, or the options are invalid.
 HeldOutScore ScoreHeldOutViews(const std::vector<CalibratedImage>& training,
                                const std::vector<CalibratedImage>& held_out,
                                const std::vector<const Mesh*>& surfaces,

@@ -23,8 +23,8 @@ struct SkippedCamera {
   std::string error;  // The Error's message.
 };
 
-// The coarse mesh, cameras and undistorted images of `frame`; a camera's unreadable image throws
-// its Error.
+// The coarse mesh, cameras and undistorted images of `frame`, and their masks when the capture
+// has masks; a camera's unreadable image or mask throws its Error.
 FrameInput ReadFrameInput(Capture* capture, int frame);
 
 // The same, except that with `skip_unreadable` a camera whose image cannot be read is left out of
@@ -33,13 +33,14 @@ FrameInput ReadFrameInput(Capture* capture, int frame);
 FrameInput ReadFrameInput(Capture* capture, int frame, bool skip_unreadable,
                           std::vector<SkippedCamera>* skipped);
 
-// Removes the cameras named in `held_out` and their images from `input` and returns them, in the
+// Removes the cameras named in `held_out` and their images (and masks) from `input` and returns
+// them, in the
 // rig's order: what is left is all that refinement may see. Throws Error when no other camera is
 // left (the others' images could not be read). Names that are no camera of `input` are ignored.
 std::vector<CalibratedImage> TakeHeldOutViews(const std::vector<std::string>& held_out,
                                               FrameInput* input);
 
-// The cameras and images of `input`, for the held-out score.
+// The cameras, images and masks of `input`, for the held-out score.
 std::vector<CalibratedImage> CalibratedImagesOf(const FrameInput& input);
 
 // Reads frames as refinement sees them (ReadFrameInput with `skip_unreadable`, the cameras named

@@ -118,11 +118,26 @@ struct RefineOptions {
 };
 
 // One frame's input: the coarse mesh and, per camera, the pinhole camera and its undistorted
-// 8-bit BGR image.
+// 8-bit BGR image, and optionally its foreground mask.
+//
+// Masks. Background pixels take no part in the energy, in two ways that together leave the
+// result unchanged whatever the background holds: the image models are built from foreground
+// pixels only (BuildImageGaussians), so no image Gaussian carries a background colour; and a
+// camera sees a vertex only where the vertex projects onto its foreground (ComputeFrameVisibility),
+// so a surface Gaussian that falls on the background in one camera is compared in the others
+// alone, not against the absence of image Gaussians there. What reads pixels directly (the
+// detail stage's samples, reference colours from pixels) reads the images with their background
+// painted black, so that no blur or bilinear read near a silhouette takes anything from what the
+// background holds; and the detail stage's samples are dropped, as vertices are, where they
+// fall on a mask shrunk by the reach of their reads (PrepareDetailEnergy), so that they do not
+// read that black either. Dropping, rather than down-weighting, keeps the energy's form: each
+// term is whole or absent.
 struct FrameInput {
   Mesh coarse;
   std::vector<Camera> cameras;
   std::vector<cv::Mat> images;
+  // Empty (no masks), or one CV_8UC1 per camera of its image's size, non-zero on the foreground.
+  std::vector<cv::Mat> masks;
   // The images' models, one per camera, when already built (ModelFrameImages), with the options
   // they were built with; empty otherwise. A frame's images are then modelled once, however many
   // stages use them (the reference colours, the forecast, the solve), and can be modelled ahead,
@@ -183,11 +198,11 @@ struct FineGroundTruth {
   bool empty() const { return k_true.size() == 0; }
 };
 
-// For each camera, which fine vertices of `mesh` (with `normals`) it sees.
-std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
-                                                               const Eigen::Matrix3Xd& normals,
-                                                               const std::vector<Camera>& cameras,
-                                                               const VisibilityOptions& options);
+// For each camera, which fine vertices of `mesh` (with `normals`) it sees. With `masks` (one per
+// camera, as FrameInput::masks) a vertex whose nearest pixel is background is not seen.
+std::vector<std::vector<unsigned char>> ComputeFrameVisibility(
+    const Mesh& mesh, const Eigen::Matrix3Xd& normals, const std::vector<Camera>& cameras,
+    const VisibilityOptions& options, const std::vector<cv::Mat>& masks = {});
 
 // The colours of the fine vertices, from the reference frame's images at its coarse surface.
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,

@@ -7,6 +7,8 @@
 //
 //   cameras.yaml                  the rig as calibrated (calibration noise applied)
 //   images/<camera>/<frame>.png   8-bit colour images, distorted with the rig's lens distortion
+//   masks/<camera>/<frame>.png    with SynthOptions::write_masks: 255 where the subject covers at
+//                                 least half of the pixel, else 0, distorted like the images
 //   meshes/<frame>.ply            coarse input mesh: the true surface without its folds, a
 //                                 smoothed copy of it, or the true surface at the coarse
 //                                 vertices (SynthOptions::coarse)
@@ -178,6 +180,13 @@ const std::vector<EnumName<CoarseInput>>& EnumNames(CoarseInput);
 enum class SynthSubject { kSkirt, kMesh };
 const std::vector<EnumName<SynthSubject>>& EnumNames(SynthSubject);
 
+// What the cameras see around the subject (SynthOptions::background): "plain" (one colour,
+// render.background) or "per_camera" (a textured wall of its own behind the subject in every
+// camera, so that no two cameras agree on the background: what a real studio's walls, floor and
+// crew do to a similarity that compares cameras).
+enum class SynthBackground { kPlain, kPerCamera };
+const std::vector<EnumName<SynthBackground>>& EnumNames(SynthBackground);
+
 struct SynthOptions {
   // kSkirt (the built-in flared tube, see `skirt`) or kMesh (the meshes at `mesh_path`).
   // Default kSkirt.
@@ -232,6 +241,10 @@ struct SynthOptions {
   // render.noise_seed. Default: supersampling 3, shading on (ambient 0.5, diffuse 0.6),
   // background dark grey.
   RenderOptions render = DefaultRenderOptions();
+  // The background of the images (see SynthBackground). Default kPlain.
+  SynthBackground background = SynthBackground::kPlain;
+  // Whether GenerateSyntheticCapture writes the foreground masks (masks/). Default false.
+  bool write_masks = false;
 
   // Seed of every random choice (texture, misalignment, calibration and sensor noise). Default 1.
   std::uint64_t seed = 1;
@@ -278,7 +291,9 @@ class SyntheticCapture {
   // Geometry and ground truth of frame `index` (0 <= index < num_frames()).
   SyntheticFrame Frame(int index) const;
   // The image camera `camera` records of `frame` (number `index`): BGR, lens distortion applied.
-  cv::Mat Image(const SyntheticFrame& frame, int index, int camera) const;
+  // When `mask` is given it receives the subject's silhouette in that image: CV_8UC1, 255 where
+  // the subject covers at least half of the pixel (its anti-aliased coverage), else 0.
+  cv::Mat Image(const SyntheticFrame& frame, int index, int camera, cv::Mat* mask = nullptr) const;
 
  private:
   struct Impl;
