@@ -90,14 +90,17 @@ constexpr double kBytesPerSurfaceSample = 205.0;
 // detail stage's two passes. The spread is real: a read in a full-resolution image (72 MB of
 // floats a camera) misses the caches that the 708 x 532 images fit in, and Sceaux at full
 // resolution, 135 M reads an evaluation against 7 M, takes 1.7 times its forecast while Sceaux
-// takes 0.6 times it; a model of the caches is left to do.
+// takes 0.6 times it; a model of the caches is left to do. On the wall clock of the idle machine
+// (2026-12-05, the held-out score included) all five captures of bench/memory_forecast.sh took
+// 0.57 to 1.0 times their forecast.
 constexpr double kSecondsPerPairWithSamples = 0.355e-6;
 constexpr double kSecondsPerSampleRead = 0.116e-6;
 
 // The held-out score, per pixel of a held-out view and training view warped into it (for the
-// three surfaces refine scores): fitted to Sceaux's two held-out views, at the capture's 708 x 532
-// and at full resolution (2832 x 2128), on 2 idle cores.
-constexpr double kSecondsPerHeldOutPixelPair = 0.2e-6;
+// three surfaces refine scores): Sceaux's two held-out views with 4 training views each took
+// 0.40 s at the capture's 708 x 532 and 6.1 s at full resolution (2832 x 2128) on 2 idle cores,
+// 0.134 and 0.127 us a pixel pair.
+constexpr double kSecondsPerHeldOutPixelPair = 0.13e-6;
 
 // The samples of a regular vertex's patch of `rings` rings after `levels` of linear subdivision:
 // the hexagon of radius rings * 2^levels without its rim.
