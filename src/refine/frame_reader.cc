@@ -125,6 +125,17 @@ FrameReadAhead::FrameReadAhead(Capture* capture, bool skip_unreadable,
       work_ahead_(std::move(work_ahead)),
       threads_(omp_get_max_threads()) {}
 
+FrameReadAhead::~FrameReadAhead() {
+  DropPending();
+  if (!thread_.joinable()) return;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    ending_ = true;
+  }
+  wake_.notify_one();
+  thread_.join();
+}
+
 void FrameReadAhead::DropPending() {
   for (Pending& pending : pending_) pending.read.wait();
   pending_.clear();
@@ -135,25 +146,31 @@ void FrameReadAhead::ReadAhead(int frame) {
   for (const Pending& pending : pending_) {
     if (pending.frame == frame) return;
   }
-  const std::shared_future<void> before =
-      pending_.empty() ? std::shared_future<void>() : pending_.back().ended;
-  auto ended = std::make_shared<std::promise<void>>();
-  Pending pending;
-  pending.frame = frame;
-  pending.ended = ended->get_future().share();
-  pending.read = std::async(std::launch::async, [this, frame, before, ended] {
-    // Tells the read queued behind this one to start, however this one ends.
-    struct SignalEnd {
-      std::promise<void>* ended;
-      ~SignalEnd() { ended->set_value(); }
-    } signal{ended.get()};
-    if (before.valid()) before.wait();
-    // Named, so that a profile tells the frame ahead's work (and that of the OpenMP workers this
-    // thread starts, which take its name) from the solve's.
-    pthread_setname_np(pthread_self(), "finecap-ahead");
-    return Read(frame, true);
-  });
-  pending_.push_back(std::move(pending));
+  std::packaged_task<Frame()> read([this, frame] { return Read(frame, true); });
+  pending_.push_back({frame, read.get_future()});
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    tasks_.push_back(std::move(read));
+  }
+  wake_.notify_one();
+  if (!thread_.joinable()) thread_ = std::thread([this] { Work(); });
+}
+
+void FrameReadAhead::Work() {
+  // Named, so that a profile tells the frame ahead's work (and that of the OpenMP workers this
+  // thread starts, which take its name) from the solve's.
+  pthread_setname_np(pthread_self(), "finecap-ahead");
+  for (;;) {
+    std::packaged_task<Frame()> read;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return ending_ || !tasks_.empty(); });
+      if (tasks_.empty()) return;  // Ending, nothing left.
+      read = std::move(tasks_.front());
+      tasks_.pop_front();
+    }
+    read();  // Its exception, if any, goes to its future.
+  }
 }
 
 void FrameReadAhead::Keep(int frame, Frame read) {

@@ -4,11 +4,14 @@
 #ifndef FINECAP_REFINE_FRAME_READER_H_
 #define FINECAP_REFINE_FRAME_READER_H_
 
+#include <condition_variable>
 #include <deque>
 #include <functional>
 #include <future>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "finecap/io/capture.h"
@@ -69,6 +72,8 @@ class FrameReadAhead {
 
   FrameReadAhead(Capture* capture, bool skip_unreadable, std::vector<std::string> held_out,
                  std::optional<ImageGaussianOptions> image_options, WorkAhead work_ahead = {});
+  // Waits for the reads under way (DropPending) and ends the reader's thread.
+  ~FrameReadAhead();
 
   // Starts reading `frame` in the background once the reads asked for before it have ended,
   // unless it is kept or already asked for.
@@ -103,11 +108,20 @@ class FrameReadAhead {
   struct Pending {
     int frame = -1;
     std::future<Frame> read;
-    std::shared_future<void> ended;  // Ready once the read has ended, whether it threw or not.
   };
+  // Runs the reads ahead, in the order asked for, until the reader goes.
+  void Work();
 
   int threads_;                  // OpenMP threads for the work ahead.
-  std::deque<Pending> pending_;  // In the order asked for: each read waits for the one before.
+  std::deque<Pending> pending_;  // In the order asked for.
+  // The reads ahead run on one thread for the reader's lifetime, started at the first: a thread
+  // per read left memory behind in the libraries that keep state per thread (OpenCV's
+  // thread-local data, ~0.8 KB a frame: bench/soak.sh), and started a new OpenMP team each time.
+  std::thread thread_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::packaged_task<Frame()>> tasks_;  // Guarded by mutex_.
+  bool ending_ = false;                            // Guarded by mutex_.
   int kept_frame_ = -1;
   Frame kept_;
 };
