@@ -198,8 +198,7 @@ void AddHeldOutScoring(const std::vector<CalibratedImage>& held_out, int num_tra
     pixel_pairs +=
         double(view.camera.width) * view.camera.height * std::min(neighbours, num_training);
   }
-  size->seconds_held_out = pixel_pairs * kSecondsPerHeldOutPixelPair;
-  size->seconds_per_frame += size->seconds_held_out;
+  size->seconds_per_frame += pixel_pairs * kSecondsPerHeldOutPixelPair;
 }
 
 void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,

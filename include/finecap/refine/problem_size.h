@@ -52,8 +52,6 @@ struct ProblemSize {
   // cores), the held-out score included once AddHeldOutScoring has added it: a rough figure,
   // within 0.5 to 2 times the wall time on the captures that bench/memory_forecast.sh covers.
   double seconds_per_frame = 0.0;
-  // Of which the held-out score (AddHeldOutScoring; 0 without held-out views).
-  double seconds_held_out = 0.0;
 };
 
 // The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
