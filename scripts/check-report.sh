@@ -3,9 +3,12 @@
 # what a reader would see: every <img> of the report loads and decodes in the browser, every
 # picture it refers to by file name exists and is a PNG or JPEG, and the screenshot exists and
 # is not of a single colour. When the report has a 3D view (finecap eval's, with three.js), its
-# canvas must show up within the screenshot and each half (input | refined) must have drawn a
-# shaded mesh: at least 2 % of its pixels off the background and at least 16 grey levels among
-# them (a blank or flat-shaded canvas has one or a few).
+# canvas must show up within the screenshot and each of its panels (input | refined | truth, as
+# labelled) must have drawn a shaded mesh: at least 2 % of its pixels off the background and at
+# least 16 grey levels among them (a blank or flat-shaded canvas has one or a few). Every picture
+# of a row of comparison panels (<figure class="panels">: the held-out photo beside what each mesh
+# predicts there and their NCC maps) must show at least 8 colours. Each panel checked is listed
+# by its label.
 #
 # Usage: scripts/check-report.sh REPORT.html OUT.png [WIDTH HEIGHT]
 #   WIDTH x HEIGHT: the browser window, CSS pixels (default 1280 x 2000); the screenshot shows
@@ -100,7 +103,8 @@ run_in_page() {
     fi
     echo "<div id=\"finecap-check\"></div><script>$script</script>"
   } >"$copy"
-  browser --dump-dom "file://$copy" | grep -o 'id="finecap-check">[^<]*' | sed 's/.*>//'
+  # At the screenshot's window size, so that layouts measured here are the screenshot's.
+  browser --window-size="$width,$height" --dump-dom "file://$copy" | grep -o 'id="finecap-check">[^<]*' | sed 's/.*>//'
   rm -f "$copy"
 }
 
@@ -140,27 +144,59 @@ window.addEventListener("load", () => {
       canvas.width + "x" + canvas.height + " " + colours.size;
 });'
 
-# The 3D view's canvas in page pixels, "X Y WIDTH HEIGHT"; "none" when the page has none.
+# The 3D view's canvas in page pixels and its panels' labels, "X Y WIDTH HEIGHT LABEL|LABEL|...";
+# "none" when the page has none.
 VIEWER_RECT_SCRIPT='
 window.addEventListener("load", () => {
   const canvas = document.querySelector("#finecap-viewer canvas");
   const box = canvas ? canvas.getBoundingClientRect() : null;
+  const labels = [...document.querySelectorAll("#finecap-viewer .viewer-label")]
+      .map(label => label.dataset.panel.replace(/[|\s]+/g, "_"));
   document.getElementById("finecap-check").textContent = box
-      ? [box.left + scrollX, box.top + scrollY, box.width, box.height].map(Math.round).join(" ")
+      ? [box.left + scrollX, box.top + scrollY, box.width, box.height].map(Math.round).join(" ") +
+        " " + (labels.length ? labels.join("|") : "input|refined")
       : "none";
 });'
 
-# For each half of the canvas region of the screenshot (input | refined): the percentage of
-# pixels off the background (the top-left pixel of the half) and the number of grey levels among
-# them, "PERCENT LEVELS PERCENT LEVELS". The region is inset by 4 pixels to skip the border, by
-# 24 at the top to skip the labels.
+# Each row of comparison panels: "ROW: LABEL COLOURS, LABEL COLOURS; ROW: ..." with the number of
+# distinct colours of each picture (0 when it did not load), "none" when the page has none.
+PANELS_SCRIPT='
+window.addEventListener("load", () => {
+  const rows = [...document.querySelectorAll("figure.panels")].map(row => {
+    const panels = [...row.querySelectorAll("img[data-panel]")].map(image => {
+      let colours = 0;
+      if (image.complete && image.naturalWidth > 0) {
+        const canvas = document.createElement("canvas");
+        canvas.width = image.naturalWidth;
+        canvas.height = image.naturalHeight;
+        const context = canvas.getContext("2d");
+        context.drawImage(image, 0, 0);
+        const pixels = context.getImageData(0, 0, canvas.width, canvas.height).data;
+        const seen = new Set();
+        for (let i = 0; i < pixels.length; i += 4) {
+          seen.add((pixels[i] << 16) | (pixels[i + 1] << 8) | pixels[i + 2]);
+        }
+        colours = seen.size;
+      }
+      return image.dataset.panel + " " + colours;
+    });
+    return row.dataset.panels + ": " + panels.join(", ");
+  });
+  document.getElementById("finecap-check").textContent = rows.length ? rows.join("; ") : "none";
+});'
+
+# For each panel of the canvas region of the screenshot (PANELS of them, side by side): the
+# percentage of pixels off the background (the top-left pixel of the panel) and the number of
+# grey levels among them, "PERCENT LEVELS PERCENT LEVELS ...". Each panel is inset by 4 pixels to
+# skip the border, by 24 at the top to skip the labels.
 VIEWER_PIXELS_SCRIPT="$SHOT_CONTEXT"'
 window.addEventListener("load", () => {
   const [x, y, width, height] = "RECT".split(" ").map(Number);
+  const count = PANELS;
   const context = shotContext();
-  const halves = [0, 1].map(half => {
-    const left = x + 4 + half * Math.floor(width / 2), top = y + 24;
-    const w = Math.floor(width / 2) - 8, h = height - 28;
+  const halves = [...Array(count).keys()].map(half => {
+    const left = x + 4 + Math.floor(half * width / count), top = y + 24;
+    const w = Math.floor(width / count) - 8, h = height - 28;
     const pixels = context.getImageData(left, top, w, h).data;
     const background = [pixels[0], pixels[1], pixels[2]];
     const levels = new Set();
@@ -176,35 +212,65 @@ window.addEventListener("load", () => {
   document.getElementById("finecap-check").textContent = halves.join(" ");
 });'
 
-# Checks the 3D view's canvas region of the screenshot `$1`; `$2` is its rectangle.
+# Checks the 3D view's canvas region of the screenshot `$1`; `$2` is its rectangle and the
+# panels' labels.
 check_viewer() {
-  local shot="$1" rect="$2" page result
-  read -r _ rect_y _ rect_height <<<"$rect"
+  local shot="$1" rect labels page result
+  read -r _ rect_y _ rect_height labels <<<"$2"
+  rect="${2% *}"
   if [ $((rect_y + rect_height)) -gt "$height" ]; then
     echo "check-report: $report: the 3D view ($rect) is below the screenshot's $height pixels" >&2
     return 1
   fi
+  local names=()
+  IFS='|' read -r -a names <<<"$labels"
   page="$(mktemp --suffix=.html)"
   printf '<img id="shot" src="data:image/png;base64,%s">' "$(base64 -w0 "$shot")" >"$page"
-  result="$(run_in_page "$page" "${VIEWER_PIXELS_SCRIPT/RECT/$rect}")"
+  local script="${VIEWER_PIXELS_SCRIPT/RECT/$rect}"
+  result="$(run_in_page "$page" "${script/PANELS/${#names[@]}}")"
   rm -f "$page"
-  local input_share input_levels refined_share refined_levels
-  read -r input_share input_levels refined_share refined_levels <<<"$result"
-  if [ -z "${refined_levels:-}" ]; then
+  local values=()
+  read -r -a values <<<"$result"
+  if [ "${#values[@]}" -ne $((2 * ${#names[@]})) ]; then
     echo "check-report: $shot: the 3D view's region could not be read back" >&2
     return 1
   fi
-  echo "check-report: 3D view: input ${input_share} % of pixels drawn, $input_levels grey" \
-    "levels; refined ${refined_share} %, $refined_levels levels"
-  local problems=0 name share levels
-  for name in input refined; do
-    share="${name}_share"
-    levels="${name}_levels"
-    if [ "${!share%.*}" -lt 2 ] || [ "${!levels}" -lt 16 ]; then
-      echo "check-report: $shot: the 3D view's $name half shows no shaded mesh" >&2
+  local problems=0 i share levels summary=""
+  for i in "${!names[@]}"; do
+    share="${values[$((2 * i))]}"
+    levels="${values[$((2 * i + 1))]}"
+    summary+="${summary:+; }${names[$i]} $share % of pixels drawn, $levels grey levels"
+    if [ "${share%.*}" -lt 2 ] || [ "$levels" -lt 16 ]; then
+      echo "check-report: $shot: the 3D view's panel '${names[$i]}' shows no shaded mesh" >&2
       problems=1
     fi
   done
+  echo "check-report: 3D view: $summary"
+  return $problems
+}
+
+# Checks every row of comparison panels of the report: each picture loaded and shows at least 8
+# colours.
+check_panels() {
+  local rows row problems=0
+  rows="$(run_in_page "$report_abs" "$PANELS_SCRIPT")"
+  case "$rows" in
+    none) echo "check-report: $report: no comparison panels"; return 0 ;;
+    "") echo "check-report: $report: the browser reported nothing of the comparison panels" >&2
+      return 1 ;;
+  esac
+  while IFS= read -r row; do
+    echo "check-report: panels $row"
+    local panel
+    while IFS= read -r panel; do
+      panel="${panel# }"
+      if [ "${panel##* }" -lt 8 ]; then
+        echo "check-report: $report: panel '${panel% *}' of '${row%%: *}' is blank" \
+          "(${panel##* } colours)" >&2
+        problems=1
+      fi
+    done < <(tr ',' '\n' <<<"${row#*: }")
+  done < <(sed 's/; /\n/g' <<<"$rows")
   return $problems
 }
 
@@ -244,5 +310,6 @@ case "$viewer_rect" in
     problems=1 ;;
   *) check_viewer "$out_abs" "$viewer_rect" || problems=1 ;;
 esac
+check_panels || problems=1
 [ "$problems" -eq 0 ] || exit 1
 echo "check-report: ok"

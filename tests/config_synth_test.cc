@@ -102,7 +102,8 @@ TEST(ConfigSynthTest, EveryPresetLoadsAndItsValuesReachSynthOptions) {
 TEST(ConfigSynthTest, PresetValuesMatchTheirFiles) {
   const std::string configs = std::string(FINECAP_SOURCE_DIR) + "/configs/";
   const SynthOptions demo = LoadConfig(configs + "synth_demo.yaml", {}).synth;
-  EXPECT_EQ(demo.cameras.count, 4);
+  EXPECT_EQ(demo.cameras.count, 8);
+  EXPECT_EQ(demo.fold_ramp_frames, 0);
   EXPECT_EQ(demo.cameras.width, 512);
   EXPECT_EQ(demo.truth_refinement, 3);
   ASSERT_EQ(demo.folds.size(), 4u);
@@ -134,19 +135,18 @@ TEST(ConfigSynthTest, PresetValuesMatchTheirFiles) {
 }
 
 // A real capture's reference frame is as coarse as any other, so the presets put folds in frame 0;
-// only the demo and the variants named *_ramp grow them from zero (an exact reference frame).
-TEST(ConfigSynthTest, OnlyTheDemoAndRampVariantsRampTheFolds) {
+// only the variants named *_ramp grow them from zero (an exact reference frame).
+TEST(ConfigSynthTest, OnlyRampVariantsRampTheFolds) {
   int ramped = 0;
   for (const std::string& preset : SynthPresets()) {
     SCOPED_TRACE(preset);
     const std::string name = std::filesystem::path(preset).stem().string();
-    const bool named_ramped =
-        name == "synth_demo" || (name.size() > 5 && name.compare(name.size() - 5, 5, "_ramp") == 0);
+    const bool named_ramped = name.size() > 5 && name.compare(name.size() - 5, 5, "_ramp") == 0;
     const SynthOptions synth = LoadConfig(preset, {}).synth;
     EXPECT_EQ(synth.fold_ramp_frames > 0, named_ramped);
     ramped += named_ramped;
   }
-  EXPECT_GE(ramped, 2);  // The demo and synth_skirt_ramp at least.
+  EXPECT_GE(ramped, 1);  // synth_skirt_ramp at least.
   const std::string configs = std::string(FINECAP_SOURCE_DIR) + "/configs/";
   EXPECT_EQ(LoadConfig(configs + "synth_skirt_ramp.yaml", {}).synth.fold_ramp_frames, 3);
   const SynthOptions smoothed = LoadConfig(configs + "synth_skirt_smoothed.yaml", {}).synth;

@@ -1,5 +1,6 @@
 #include "finecap/eval/html_report.h"
 
+#include <cstdio>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -140,11 +141,73 @@ TEST(HtmlReport, WrittenFileIsSelfContained) {
   EXPECT_FALSE(Contains(html, "http:"));
   EXPECT_FALSE(Contains(html, "https:"));
   EXPECT_FALSE(Contains(html, "url("));
-  EXPECT_FALSE(Contains(html, "href="));
+  // Links only within the page: the contents, one per section.
+  EXPECT_EQ(Count(html, "href="), 2u);
+  EXPECT_EQ(Count(html, "href=\"#"), 2u);
   EXPECT_EQ(Count(html, "src="), 2u);
   EXPECT_EQ(Count(html, "src=\"data:"), 2u);
-  EXPECT_EQ(Count(html, "<section>"), Count(html, "</section>"));
-  EXPECT_EQ(Count(html, "<section>"), 2u);
+  EXPECT_EQ(Count(html, "<section"), Count(html, "</section>"));
+  EXPECT_EQ(Count(html, "<section"), 2u);
+}
+
+TEST(HtmlReport, ContentsLinkEverySectionByAUniqueId) {
+  HtmlReport report("Contents");
+  report.AddSection("3D view");
+  report.AddSection("Held-out cameras");
+  report.AddSection("Held-out cameras");
+  report.AddSection("Confidence", "per-vertex confidence");
+  const std::string html = report.Html();
+  for (const std::string id :
+       {"3d-view", "held-out-cameras", "held-out-cameras-2", "per-vertex-confidence"}) {
+    SCOPED_TRACE(id);
+    EXPECT_EQ(Count(html, "<section id=\"" + id + "\">"), 1u);
+    EXPECT_EQ(Count(html, "href=\"#" + id + "\""), 1u);
+  }
+  EXPECT_LT(html.find("href=\"#3d-view\""), html.find("<section id=\"3d-view\">"));
+  // One section needs no contents.
+  HtmlReport single("Single");
+  single.AddSection("Only");
+  EXPECT_FALSE(Contains(single.Html(), "href="));
+}
+
+TEST(HtmlReport, PanelRowLabelsEveryPictureAndKeepsItsPixels) {
+  HtmlReport report("Panels");
+  cv::Mat grey(6, 5, CV_8UC1, cv::Scalar(90));
+  report.AddPanelRow("held-out frame 000000, cam03",
+                     {{"photo", Gradient()}, {"predicted <refined>", grey}}, "a caption");
+  const std::string html = report.Html();
+  EXPECT_TRUE(Contains(html, "data-panels=\"held-out frame 000000, cam03\""));
+  EXPECT_TRUE(Contains(html, "data-panel=\"photo\""));
+  EXPECT_TRUE(Contains(html, "data-panel=\"predicted &lt;refined&gt;\""));
+  EXPECT_TRUE(Contains(html, "<figcaption>a caption</figcaption>"));
+  const std::vector<std::string> images = EmbeddedImages(html);
+  ASSERT_EQ(images.size(), 2u);
+  const cv::Mat decoded =
+      cv::imdecode(std::vector<uchar>(images[0].begin(), images[0].end()), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(decoded.empty());
+  EXPECT_EQ(cv::norm(decoded, Gradient(), cv::NORM_INF), 0.0);
+  ExpectErrorMentions([&] { report.AddPanelRow("row", {}); }, {"row", "no panel"});
+  ExpectErrorMentions(
+      [&] {
+        report.AddPanelRow("row", {{"blank", cv::Mat()}});
+      },
+      {"blank", "empty"});
+}
+
+TEST(HtmlReport, ColorScaleRunsFromBlueToDarkRedWithItsEndsInItsUnit) {
+  const std::string html = ColorScaleHtml("|k - k_true|", 0.0, 15.5, "mm");
+  EXPECT_TRUE(Contains(html, "0 mm"));
+  EXPECT_TRUE(Contains(html, "15.5 mm"));
+  EXPECT_TRUE(Contains(html, "|k - k_true|"));
+  // OpenCV's turbo map: dark blue first, dark red last.
+  const size_t first = html.find("rgb("), last = html.rfind("rgb(");
+  ASSERT_NE(first, std::string::npos);
+  int r0, g0, b0, r1, g1, b1;
+  ASSERT_EQ(std::sscanf(html.c_str() + first, "rgb(%d,%d,%d)", &r0, &g0, &b0), 3);
+  ASSERT_EQ(std::sscanf(html.c_str() + last, "rgb(%d,%d,%d)", &r1, &g1, &b1), 3);
+  EXPECT_GT(b0, r0);
+  EXPECT_GT(r1, b1);
+  ExpectErrorMentions([] { ColorScaleHtml("ncc", 1.0, -1.0, ""); }, {"ncc", "low below the high"});
 }
 
 TEST(HtmlReport, BadImagesNameTheProblem) {

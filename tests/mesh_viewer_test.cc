@@ -75,10 +75,21 @@ Camera FrontCamera() {
   return camera;
 }
 
+// The panels of a capture with ground truth: input, refined coloured by its error, truth.
+std::vector<ViewerPanel> Panels() {
+  return {{"input", 0xa9b4c4, std::nullopt},
+          {"refined", 0xd9bc96, ViewerColorScale{"|k - k_true|", 12.5, "mm"}},
+          {"truth", 0xa8c4a2, std::nullopt}};
+}
+
+// Input, refined (the input bulged by `bulge` in z, coloured red) and truth (bulged twice as far).
 ViewerFrame Frame(const std::string& name, double bulge) {
-  ViewerFrame frame{name, testing_meshes::GridMesh(4, 3), {}};
-  frame.refined = frame.input;
-  frame.refined.vertices.row(2).array() += bulge;
+  const Mesh input = testing_meshes::GridMesh(4, 3);
+  ViewerFrame frame{name, {{input, {}}, {input, {}}, {input, {}}}};
+  frame.surfaces[1].mesh.vertices.row(2).array() += bulge;
+  frame.surfaces[1].vertex_colors = Eigen::Matrix3Xd::Zero(3, input.num_vertices());
+  frame.surfaces[1].vertex_colors.row(0).setOnes();
+  frame.surfaces[2].mesh.vertices.row(2).array() += 2.0 * bulge;
   return frame;
 }
 
@@ -119,42 +130,75 @@ TEST(MeshViewerTest, EmbedsTheLibraryTheFacesOnceAndEveryFramesPositions) {
   const ThreeJsLibrary library{"/nowhere", "var THREE = {}; // '</script>' in a comment",
                                "THREE.OrbitControls = function () {};"};
   const std::vector<ViewerFrame> frames = {Frame("000000", 0.0), Frame("000004", 0.01)};
-  const std::string html = MeshViewerHtml(frames, FrontCamera(), library);
+  const std::string html = MeshViewerHtml(Panels(), frames, FrontCamera(), library);
   // The library's text cannot end its <script> element early.
   EXPECT_EQ(Count(html, "</script>"), 3u);
   EXPECT_NE(html.find("var THREE = {}; // '<\\/script>'"), std::string::npos);
   EXPECT_NE(html.find("THREE.OrbitControls = function () {};"), std::string::npos);
-  EXPECT_EQ(Count(html, ExpectedFaces(frames[0].input)), 1u);
+  EXPECT_EQ(Count(html, ExpectedFaces(frames[0].surfaces[0].mesh)), 1u);
   // Every frame's positions decode to the meshes' within half a quantisation step, 1.5e-5 of the
-  // box of all meshes (3 x 2 x 0.01 here).
+  // box of all meshes (3 x 2 x 0.02 here).
   const Eigen::Vector3d origin = VectorIn(html, "origin"), step = VectorIn(html, "step");
   EXPECT_LT(step.maxCoeff(), 3.1 / 65535);
-  const std::string last =
-      Match(html, R"re("name": "000004", "input": "[^"]*", "refined": "([^"]*)")re");
-  const Eigen::Matrix3Xd refined = DecodedPositions(last, origin, step);
-  ASSERT_EQ(refined.cols(), frames[1].refined.num_vertices());
-  EXPECT_LT((refined - frames[1].refined.vertices).cwiseAbs().maxCoeff(), 0.51 * step.maxCoeff());
-  const std::string first = Match(html, R"re("name": "000000", "input": "([^"]*)")re");
-  EXPECT_LT(
-      (DecodedPositions(first, origin, step) - frames[0].input.vertices).cwiseAbs().maxCoeff(),
-      0.51 * step.maxCoeff());
+  const std::string surface = R"re(\{"positions": "([^"]*)", "colors": "([^"]*)"\})re";
+  std::smatch match;
+  const std::regex last_frame(R"re("name": "000004", "surfaces": \[)re" + surface + ", " + surface +
+                              ", " + surface);
+  ASSERT_TRUE(std::regex_search(html, match, last_frame));
+  for (int p = 0; p < 3; ++p) {
+    SCOPED_TRACE(p);
+    const Mesh& mesh = frames[1].surfaces[p].mesh;
+    const Eigen::Matrix3Xd decoded = DecodedPositions(match[1 + 2 * p].str(), origin, step);
+    ASSERT_EQ(decoded.cols(), mesh.num_vertices());
+    EXPECT_LT((decoded - mesh.vertices).cwiseAbs().maxCoeff(), 0.51 * step.maxCoeff());
+  }
+  // The refined mesh's colours as RGB bytes (red), the others none.
+  const std::string colors = testing_util::Base64Decode(match[4].str());
+  ASSERT_EQ(colors.size(), 3u * frames[1].surfaces[1].mesh.num_vertices());
+  EXPECT_EQ(static_cast<unsigned char>(colors[0]), 255);
+  EXPECT_EQ(static_cast<unsigned char>(colors[1]), 0);
+  EXPECT_TRUE(match[2].str().empty());
+  EXPECT_TRUE(match[6].str().empty());
+  const std::string first =
+      Match(html, R"re("name": "000000", "surfaces": \[\{"positions": "([^"]*)")re");
+  EXPECT_LT((DecodedPositions(first, origin, step) - frames[0].surfaces[0].mesh.vertices)
+                .cwiseAbs()
+                .maxCoeff(),
+            0.51 * step.maxCoeff());
   EXPECT_NE(html.find("<canvas"), std::string::npos);
   EXPECT_NE(html.find("type=\"range\""), std::string::npos);
+  // A label per panel, and the colour scale of the refined panel with its top in mm.
+  EXPECT_EQ(Count(html, "class=\"viewer-label\""), 3u);
+  EXPECT_NE(html.find("data-panel=\"truth\""), std::string::npos);
+  EXPECT_EQ(Count(html, "class=\"color-scale\""), 1u);
+  EXPECT_NE(html.find("data-high=\"12.5\""), std::string::npos);
+  EXPECT_NE(html.find("12.5 mm"), std::string::npos);
   // The view starts on the camera's side of the mesh (z < 0), its up the image's up (-y).
   EXPECT_TRUE(std::regex_search(html, std::regex(R"re("eye": \[[^\]]*, -[0-9.e]+\])re")));
   EXPECT_TRUE(std::regex_search(html, std::regex(R"re("up": \[-?0, -1, -?0\])re")));
 }
 
-TEST(MeshViewerTest, RefusesNoFramesAndMeshesOfAnotherTopology) {
+TEST(MeshViewerTest, RefusesNoFramesAndSurfacesThatDoNotFit) {
   const ThreeJsLibrary library{"/nowhere", "", ""};
-  ExpectErrorMentions([&] { MeshViewerHtml({}, FrontCamera(), library); }, {"no frame"});
+  ExpectErrorMentions([&] { MeshViewerHtml(Panels(), {}, FrontCamera(), library); }, {"no frame"});
+  ExpectErrorMentions([&] { MeshViewerHtml({}, {Frame("000000", 0.0)}, FrontCamera(), library); },
+                      {"no panel"});
   ViewerFrame other = Frame("000001", 0.0);
-  other.refined = testing_meshes::GridMesh(5, 3);
+  other.surfaces[1].mesh = testing_meshes::GridMesh(5, 3);
+  other.surfaces[1].vertex_colors.resize(3, 0);
   ExpectErrorMentions(
       [&] {
-        MeshViewerHtml({Frame("000000", 0.0), other}, FrontCamera(), library);
+        MeshViewerHtml(Panels(), {Frame("000000", 0.0), other}, FrontCamera(), library);
       },
-      {"000001", "topology"});
+      {"000001", "refined", "topology"});
+  ViewerFrame missing = Frame("000002", 0.0);
+  missing.surfaces.pop_back();
+  ExpectErrorMentions([&] { MeshViewerHtml(Panels(), {missing}, FrontCamera(), library); },
+                      {"000002", "2 surfaces for 3 panels"});
+  ViewerFrame colours = Frame("000003", 0.0);
+  colours.surfaces[1].vertex_colors.conservativeResize(3, 2);
+  ExpectErrorMentions([&] { MeshViewerHtml(Panels(), {colours}, FrontCamera(), library); },
+                      {"000003", "2 vertex colours for 12 vertices"});
 }
 
 }  // namespace

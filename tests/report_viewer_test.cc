@@ -1,7 +1,9 @@
-// The report's 3D view seen in a browser: finecap eval's report.html of a tiny refined run, opened
-// in headless Chromium by scripts/check-report.sh, must show a shaded mesh in both halves of the
-// viewer's canvas (not a blank one). Skipped with a message where three.js is not installed or
-// Chromium cannot be installed or started.
+// The report seen in a browser: finecap eval's report.html of a tiny refined run with ground truth
+// and a held-out camera, opened in headless Chromium by scripts/check-report.sh, must show a
+// shaded mesh in every panel of the 3D view (input, refined coloured by its error, truth) and the
+// held-out comparison panels (the photo, what each mesh predicts there, their NCC maps), none
+// blank. Skipped with a message where three.js is not installed or Chromium cannot be installed
+// or started.
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -21,7 +23,7 @@ namespace {
 
 constexpr int kChromiumUnavailable = 77;  // scripts/check-report.sh's exit code.
 
-TEST(ReportViewerTest, ChromiumShowsAShadedMeshInBothHalves) {
+TEST(ReportViewerTest, ChromiumShowsTruthAndHeldOutComparisons) {
   if (!FindThreeJs()) GTEST_SKIP() << "three.js not installed (Debian's libjs-three)";
   const std::string root = testing_util::MakeTempDir("report_viewer");
   GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(2), root + "/capture");
@@ -32,6 +34,7 @@ TEST(ReportViewerTest, ChromiumShowsAShadedMeshInBothHalves) {
   config.refine.solver.max_iterations = 5;
   config.refine.solver.num_threads = 1;
   config.eval.flow = "none";
+  config.validation.cameras = {"cam02"};
   ASSERT_EQ(RunRefine(config), 0);
   ASSERT_EQ(RunEval(config), 0);
   const std::string command = "bash " FINECAP_SOURCE_DIR "/scripts/check-report.sh " + root +
@@ -42,7 +45,21 @@ TEST(ReportViewerTest, ChromiumShowsAShadedMeshInBothHalves) {
   const std::string log = testing_util::FileBytes(root + "/check.log");
   if (WEXITSTATUS(status) == kChromiumUnavailable) GTEST_SKIP() << log;
   EXPECT_EQ(WEXITSTATUS(status), 0) << log;
-  EXPECT_NE(log.find("check-report: 3D view: input"), std::string::npos) << log;
+  EXPECT_NE(log.find("check-report: 3D view: input "), std::string::npos) << log;
+  EXPECT_NE(log.find("; refined,_coloured_by_its_error "), std::string::npos) << log;
+  EXPECT_NE(log.find("; truth "), std::string::npos) << log;
+  // Both frames' comparison rows, each with its five pictures.
+  for (const std::string frame : {"000000", "000001"}) {
+    SCOPED_TRACE(frame);
+    const size_t row = log.find("check-report: panels held-out frame " + frame + ", cam02: ");
+    ASSERT_NE(row, std::string::npos) << log;
+    const std::string line = log.substr(row, log.find('\n', row) - row);
+    for (const std::string panel :
+         {"photo (held out) ", "predicted by the input ", "predicted by the refined mesh ",
+          "NCC of the input ", "NCC of the refined mesh "}) {
+      EXPECT_NE(line.find(panel), std::string::npos) << line;
+    }
+  }
 }
 
 }  // namespace

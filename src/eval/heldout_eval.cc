@@ -61,6 +61,11 @@ std::string ViewCaption(const std::string& frame_name, const HeldOutViewScore& v
   return caption.str();
 }
 
+// The labels of the comparison panels, in the order of the held-out picture's parts.
+constexpr const char* kPanelLabels[] = {"photo (held out)", "predicted by the input",
+                                        "predicted by the refined mesh", "NCC of the input",
+                                        "NCC of the refined mesh"};
+
 // The names metrics.json gives the surfaces, in HeldOutSurface order.
 constexpr const char* kSurfaceNames[kNumHeldOutSurfaces] = {"input", "subdivided", "refined"};
 
@@ -100,25 +105,36 @@ HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_camer
                                   const HeldOutOptions& options, const std::string& frame_name,
                                   FrameInput frame, const Mesh& coarse, const Mesh& input,
                                   const Mesh& refined, const std::string& eval_dir,
+                                  bool keep_panels,
                                   std::vector<std::pair<std::string, std::string>>* pictures) {
   const std::vector<CalibratedImage> held_out = TakeHeldOutViews(held_out_cameras, &frame);
   std::vector<HeldOutViewMaps> maps;
-  HeldOutFrame result{frame_name, ScoreHeldOutViews(CalibratedImagesOf(frame), held_out,
-                                                    {&coarse, &input, &refined}, options, &maps)};
+  HeldOutFrame result;
+  result.frame = frame_name;
+  result.score = ScoreHeldOutViews(CalibratedImagesOf(frame), held_out, {&coarse, &input, &refined},
+                                   options, &maps);
   for (size_t h = 0; h < held_out.size(); ++h) {
     const cv::Mat& image = held_out[h].image;
     const cv::Rect box = WarpedBox(maps[h], image.size());
     const HeldOutViewMaps& view = maps[h];
+    const std::vector<cv::Mat> parts = {image(box), view.warped[kHeldOutCoarse](box),
+                                        view.warped[kHeldOutRefined](box),
+                                        NccPicture(view.ncc[kHeldOutCoarse], image)(box),
+                                        NccPicture(view.ncc[kHeldOutRefined], image)(box)};
     cv::Mat picture;
-    cv::hconcat(std::vector<cv::Mat>{image(box), view.warped[kHeldOutCoarse](box),
-                                     view.warped[kHeldOutRefined](box),
-                                     NccPicture(view.ncc[kHeldOutCoarse], image)(box),
-                                     NccPicture(view.ncc[kHeldOutRefined], image)(box)},
-                picture);
+    cv::hconcat(parts, picture);
     const std::string path =
         eval_dir + "/heldout_" + frame_name + "_" + held_out[h].camera.name + ".png";
     WritePng(path, picture);
-    pictures->push_back({path, ViewCaption(frame_name, result.score.views[h])});
+    const std::string caption = ViewCaption(frame_name, result.score.views[h]);
+    pictures->push_back({path, caption});
+    if (keep_panels) {
+      std::vector<ReportPanel> panels;
+      for (size_t p = 0; p < parts.size(); ++p)
+        panels.push_back({kPanelLabels[p], parts[p].clone()});
+      result.panels.push_back(std::move(panels));
+      result.captions.push_back(caption);
+    }
   }
   return result;
 }
@@ -163,7 +179,6 @@ std::string HeldOutFrameJson(const HeldOutFrame& frame) {
 
 void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOptions& options,
                        HtmlReport* report) {
-  report->AddSection("Held-out cameras");
   std::ostringstream text;
   text << "Each held-out image against the " << options.neighbours
        << " nearest training views warped into it through the input as given (the coarse mesh), "
@@ -191,6 +206,21 @@ void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOpt
   report->AddTable({"", "training views", "NCC input", "NCC subdivided", "NCC refined", "MAD input",
                     "MAD subdivided", "MAD refined"},
                    rows, "Held-out photo-consistency, pooled, per frame and per held-out view");
+  bool any_panels = false;
+  for (const HeldOutFrame& frame : frames) any_panels = any_panels || !frame.panels.empty();
+  if (!any_panels) return;
+  report->AddParagraph(
+      "Each held-out photo beside what the input as given and the refined mesh predict there: the "
+      "nearest training view warped into the held-out camera through each mesh. Where a mesh is "
+      "right, its prediction matches the photo and its NCC map is red; where it is wrong, the "
+      "warped texture shifts and the map turns blue.");
+  report->AddRawHtml(ColorScaleHtml("local NCC", -1.0, 1.0, ""));
+  for (const HeldOutFrame& frame : frames) {
+    for (size_t v = 0; v < frame.panels.size(); ++v) {
+      report->AddPanelRow("held-out frame " + frame.frame + ", " + frame.score.views[v].camera,
+                          frame.panels[v], frame.captions[v]);
+    }
+  }
 }
 
 }  // namespace internal

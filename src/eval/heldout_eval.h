@@ -23,16 +23,22 @@ constexpr int kNumHeldOutSurfaces = 3;
 struct HeldOutFrame {
   std::string frame;
   HeldOutScore score;
+  // Per held-out view when kept (see EvaluateHeldOutFrame), else empty: the photo, what the input
+  // as given and the refined mesh predict there, and their NCC maps, cut to the subject.
+  std::vector<std::vector<ReportPanel>> panels;
+  std::vector<std::string> captions;  // One per entry of `panels`.
 };
 
 // Scores `coarse` (the frame's coarse mesh as given), `input` (its subdivision) and `refined` in
 // the views of `frame` named in `held_out_cameras` (training views: the rest of `frame`), writes
 // one picture per held-out view (the input as given beside the refined mesh) to
-// eval_dir/heldout_<frame>_<camera>.png and appends its path and caption to `*pictures`.
+// eval_dir/heldout_<frame>_<camera>.png and appends its path and caption to `*pictures`. With
+// `keep_panels` the result also holds the pictures' parts, for the report's comparison panels.
 HeldOutFrame EvaluateHeldOutFrame(const std::vector<std::string>& held_out_cameras,
                                   const HeldOutOptions& options, const std::string& frame_name,
                                   FrameInput frame, const Mesh& coarse, const Mesh& input,
                                   const Mesh& refined, const std::string& eval_dir,
+                                  bool keep_panels,
                                   std::vector<std::pair<std::string, std::string>>* pictures);
 
 // The means over every frame's held-out views, per surface (HeldOutSurface).
@@ -43,7 +49,8 @@ std::vector<SurfaceScore> PooledHeldOutScore(const std::vector<HeldOutFrame>& fr
 std::string HeldOutPooledJson(const std::vector<HeldOutFrame>& frames, const std::string& indent);
 std::string HeldOutFrameJson(const HeldOutFrame& frame);
 
-// The report's table of held-out figures: pooled, per frame and per view.
+// What the report's section of the held-out cameras holds: the table of figures (pooled, per frame
+// and per view), then the comparison panels of the frames that kept them.
 void AddHeldOutSection(const std::vector<HeldOutFrame>& frames, const HeldOutOptions& options,
                        HtmlReport* report);
 

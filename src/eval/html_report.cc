@@ -1,9 +1,12 @@
 #include "finecap/eval/html_report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+
+#include <opencv2/imgproc.hpp>
 
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
@@ -27,7 +30,19 @@ td.number { text-align: right; font-variant-numeric: tabular-nums; }
 figure { margin: 1em 0; }
 figure img { max-width: 100%; border: 1px solid #ddd; }
 figcaption { color: #555; font-size: 0.9em; }
+nav.contents { font-size: 0.95em; }
+nav.contents a { margin-right: 1.2em; }
+figure.panels > div.row { display: flex; flex-wrap: wrap; gap: 6px; align-items: flex-start; }
+figure.panels div.panel { flex: 1 1 0; min-width: 120px; text-align: center; }
+figure.panels div.panel div { font-size: 0.85em; font-weight: bold; color: #334; }
+figure.panels div.panel img { width: 100%; image-rendering: pixelated; }
+div.color-scale { display: flex; align-items: center; gap: 0.6em; font-size: 0.9em;
+                  margin: 0.4em 0; }
+div.color-scale .bar { width: 240px; height: 14px; border: 1px solid #889; }
 )";
+
+// Colour stops of the legend's bar: enough that the CSS gradient follows the turbo map closely.
+constexpr int kColorScaleStops = 17;
 
 bool StartsWith(const std::string& bytes, const std::string& prefix) {
   return bytes.compare(0, prefix.size(), prefix) == 0;
@@ -38,6 +53,27 @@ std::string ImageMimeType(const std::string& bytes) {
   if (StartsWith(bytes, std::string("\x89PNG\r\n\x1a\n", 8))) return "image/png";
   if (StartsWith(bytes, "\xff\xd8\xff")) return "image/jpeg";
   return "";
+}
+
+// An id for an HTML element made of `text`: lower-case letters and digits, runs of anything else
+// as one '-'.
+std::string IdOf(const std::string& text) {
+  std::string id;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c))) {
+      id += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else if (!id.empty() && id.back() != '-') {
+      id += '-';
+    }
+  }
+  while (!id.empty() && id.back() == '-') id.pop_back();
+  return id.empty() ? "section" : id;
+}
+
+std::string LegendNumber(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3g", value);
+  return buffer;
 }
 
 }  // namespace
@@ -89,6 +125,31 @@ std::string Base64Encode(const std::string& bytes) {
   return encoded;
 }
 
+std::string ColorScaleHtml(const std::string& title, double low, double high,
+                           const std::string& unit) {
+  Require(std::isfinite(low) && std::isfinite(high) && low < high, "colour scale '" + title + "'",
+          "needs finite ends, the low below the high, got " + std::to_string(low) + " and " +
+              std::to_string(high));
+  cv::Mat levels(1, kColorScaleStops, CV_8U), bgr;
+  for (int i = 0; i < kColorScaleStops; ++i) {
+    levels.at<unsigned char>(0, i) =
+        cv::saturate_cast<unsigned char>(255.0 * i / (kColorScaleStops - 1));
+  }
+  cv::applyColorMap(levels, bgr, cv::COLORMAP_TURBO);
+  std::string gradient = "linear-gradient(to right";
+  for (int i = 0; i < kColorScaleStops; ++i) {
+    const cv::Vec3b pixel = bgr.at<cv::Vec3b>(0, i);
+    gradient += ", rgb(" + std::to_string(pixel[2]) + "," + std::to_string(pixel[1]) + "," +
+                std::to_string(pixel[0]) + ")";
+  }
+  gradient += ")";
+  const std::string suffix = unit.empty() ? "" : " " + EscapeHtml(unit);
+  return "<div class=\"color-scale\" data-low=\"" + LegendNumber(low) + "\" data-high=\"" +
+         LegendNumber(high) + "\"><span>" + EscapeHtml(title) + "</span><span>" +
+         LegendNumber(low) + suffix + "</span><span class=\"bar\" style=\"background: " + gradient +
+         ";\"></span><span>" + LegendNumber(high) + suffix + "</span></div>\n";
+}
+
 TableCell TableCell::Number(double number, int significant_digits) {
   return TableCell(FormatNumber(number, significant_digits), true);
 }
@@ -104,9 +165,17 @@ HtmlReport::HtmlReport(const std::string& title) : title_(title) {}
 
 std::string HtmlReport::Where() const { return "HTML report '" + title_ + "'"; }
 
-void HtmlReport::AddSection(const std::string& heading) {
+void HtmlReport::AddSection(const std::string& heading, const std::string& id) {
   if (section_open_) body_ += "</section>\n";
-  body_ += "<section>\n<h2>" + EscapeHtml(heading) + "</h2>\n";
+  std::string anchor = IdOf(id.empty() ? heading : id);
+  // Ids stay unique when two sections share a heading.
+  for (int n = 2; std::any_of(contents_.begin(), contents_.end(),
+                              [&](const auto& entry) { return entry.first == anchor; });
+       ++n) {
+    anchor = IdOf(id.empty() ? heading : id) + "-" + std::to_string(n);
+  }
+  contents_.push_back({anchor, heading});
+  body_ += "<section id=\"" + anchor + "\">\n<h2>" + EscapeHtml(heading) + "</h2>\n";
   section_open_ = true;
 }
 
@@ -155,6 +224,27 @@ void HtmlReport::AddImage(const cv::Mat& image, const std::string& caption) {
   AddEmbeddedImage("image/png", internal::EncodePng(image, Where()), caption);
 }
 
+void HtmlReport::AddPanelRow(const std::string& name, const std::vector<ReportPanel>& panels,
+                             const std::string& caption) {
+  Require(!panels.empty(), Where(), "a row of panels '" + name + "' has no panel");
+  std::string row =
+      "<figure class=\"panels\" data-panels=\"" + EscapeHtml(name) + "\"><div class=\"row\">";
+  for (const ReportPanel& panel : panels) {
+    Require(!panel.image.empty(), Where(),
+            "panel '" + panel.label + "' of '" + name + "' has an empty picture");
+    Require(panel.image.depth() == CV_8U &&
+                (panel.image.channels() == 1 || panel.image.channels() == 3),
+            Where(), "panel '" + panel.label + "' of '" + name + "' must be 8-bit grey or BGR");
+    row += "<div class=\"panel\"><div>" + EscapeHtml(panel.label) + "</div><img alt=\"" +
+           EscapeHtml(name + ": " + panel.label) + "\" data-panel=\"" + EscapeHtml(panel.label) +
+           "\" src=\"data:image/png;base64," +
+           Base64Encode(internal::EncodePng(panel.image, Where())) + "\"></div>";
+  }
+  row += "</div>";
+  if (!caption.empty()) row += "<figcaption>" + EscapeHtml(caption) + "</figcaption>";
+  body_ += row + "</figure>\n";
+}
+
 void HtmlReport::AddRawHtml(const std::string& html) { body_ += html; }
 
 void HtmlReport::AddEmbeddedImage(const std::string& mime_type, const std::string& bytes,
@@ -168,8 +258,17 @@ void HtmlReport::AddEmbeddedImage(const std::string& mime_type, const std::strin
 std::string HtmlReport::Html() const {
   return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" +
          EscapeHtml(title_) + "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n<h1>" +
-         EscapeHtml(title_) + "</h1>\n" + body_ + (section_open_ ? "</section>\n" : "") +
-         "</body>\n</html>\n";
+         EscapeHtml(title_) + "</h1>\n" + Contents() + body_ +
+         (section_open_ ? "</section>\n" : "") + "</body>\n</html>\n";
+}
+
+std::string HtmlReport::Contents() const {
+  if (contents_.size() < 2) return "";
+  std::string contents = "<nav class=\"contents\">";
+  for (const auto& [id, heading] : contents_) {
+    contents += "<a href=\"#" + id + "\">" + EscapeHtml(heading) + "</a>";
+  }
+  return contents + "</nav>\n";
 }
 
 void HtmlReport::Write(const std::string& path) const { WriteTextFileAtomically(path, Html()); }

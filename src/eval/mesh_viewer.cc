@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -28,25 +29,25 @@ constexpr int kQuantisationLevels = 65535;
 // The vertical field of view the viewer starts with, degrees; the mesh fills most of it.
 constexpr double kFieldOfViewDeg = 30.0;
 
-// The viewer's page part: the canvas (two halves, input | refined, one camera), their labels and
-// the frame slider.
-constexpr char kViewerMarkup[] = R"html(<div class="finecap-viewer" id="finecap-viewer">
+// The viewer's page part: the canvas (one part per panel, one camera), the panels' labels (added
+// by MarkupOf), the colour scales and the frame slider.
+constexpr char kViewerMarkupStart[] = R"html(<div class="finecap-viewer" id="finecap-viewer">
 <div style="position: relative;">
 <canvas style="width: 100%; height: 520px; display: block; border: 1px solid #ccd;
   background: #f4f4f8;"></canvas>
-<div style="position: absolute; top: 6px; left: 10px; font-weight: bold;">input</div>
-<div style="position: absolute; top: 6px; left: calc(50% + 10px); font-weight: bold;">refined</div>
-</div>
-<p class="viewer-controls">Frame <input type="range" min="0" value="0" step="1" style="width: 40%;">
-<span class="viewer-frame"></span>. Drag to orbit, right-drag to pan, wheel to zoom; both halves
+)html";
+constexpr char kViewerMarkupEnd[] =
+    R"html(<p class="viewer-controls">Frame <input type="range" min="0" value="0" step="1" style="width: 40%;">
+<span class="viewer-frame"></span>. Drag to orbit, right-drag to pan, wheel to zoom; the panels
 share one camera.</p>
 <p class="viewer-note" style="color: #a33;"></p>
 </div>
 )html";
 
-// Decodes the data, builds one scene with both meshes and draws each into its half of the canvas.
-// The directional light hangs off the camera (above and to the left of the view direction), so
-// folds stay shaded from any orbit; the hemisphere light keeps the far side readable.
+// Decodes the data, builds one scene with every panel's mesh and draws each into its part of the
+// canvas. The directional light hangs off the camera (above and to the left of the view
+// direction), so folds stay shaded from any orbit; the hemisphere light keeps the far side
+// readable. A panel with vertex colours multiplies them into its shading.
 constexpr char kViewerScript[] = R"js(
 (function () {
   const data = FINECAP_VIEWER_DATA;
@@ -78,8 +79,17 @@ constexpr char kViewerScript[] = R"js(
     }
     return result;
   }
+  function colours(base64) {
+    if (!base64) return null;
+    const rgb = new Uint8Array(bytes(base64));
+    const result = new Float32Array(rgb.length);
+    for (let i = 0; i < rgb.length; ++i) result[i] = rgb[i] / 255;
+    return result;
+  }
   const frames = data.frames.map(frame => ({name: frame.name,
-      input: positions(frame.input), refined: positions(frame.refined)}));
+      surfaces: frame.surfaces.map(surface => ({positions: positions(surface.positions),
+                                                colours: colours(surface.colors)}))}));
+  const count = frames[0].surfaces[0].positions.length;
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0xf4f4f8);
   scene.add(new THREE.HemisphereLight(0xffffff, 0x606070, 0.5));
@@ -92,38 +102,51 @@ constexpr char kViewerScript[] = R"js(
   camera.add(light);
   camera.add(light.target);
   scene.add(camera);
-  function makeMesh(colour) {
+  function makeMesh(panel) {
     const geometry = new THREE.BufferGeometry();
     geometry.setIndex(faces);
-    geometry.setAttribute("position",
-        new THREE.BufferAttribute(new Float32Array(frames[0].input.length), 3));
-    const material = new THREE.MeshStandardMaterial({color: colour, roughness: 0.9,
+    geometry.setAttribute("position", new THREE.BufferAttribute(new Float32Array(count), 3));
+    geometry.setAttribute("color", new THREE.BufferAttribute(new Float32Array(count), 3));
+    const material = new THREE.MeshStandardMaterial({color: panel.color, roughness: 0.9,
                                                      metalness: 0.0, side: THREE.DoubleSide});
     const mesh = new THREE.Mesh(geometry, material);
     scene.add(mesh);
     return mesh;
   }
-  const meshes = [makeMesh(0xa9b4c4), makeMesh(0xd9bc96)];
+  const meshes = data.panels.map(makeMesh);
   function render() {
     const width = canvas.clientWidth, height = canvas.clientHeight;
     renderer.setPixelRatio(window.devicePixelRatio || 1);
     renderer.setSize(width, height, false);
-    camera.aspect = width / 2 / height;
+    camera.aspect = width / meshes.length / height;
     camera.updateProjectionMatrix();
     renderer.setScissorTest(true);
-    meshes.forEach((shown, half) => {
+    meshes.forEach((shown, index) => {
       meshes.forEach(mesh => { mesh.visible = mesh === shown; });
-      renderer.setViewport(half * width / 2, 0, width / 2, height);
-      renderer.setScissor(half * width / 2, 0, width / 2, height);
+      // Whole pixels, each part starting where the one before ends: no column left undrawn.
+      const left = Math.round(index * width / meshes.length);
+      const right = Math.round((index + 1) * width / meshes.length);
+      renderer.setViewport(left, 0, right - left, height);
+      renderer.setScissor(left, 0, right - left, height);
       renderer.render(scene, camera);
     });
   }
   function showFrame(index) {
     const frame = frames[index];
-    [frame.input, frame.refined].forEach((positions, i) => {
-      const geometry = meshes[i].geometry;
-      geometry.attributes.position.array.set(positions);
+    frame.surfaces.forEach((surface, i) => {
+      const mesh = meshes[i], geometry = mesh.geometry;
+      geometry.attributes.position.array.set(surface.positions);
       geometry.attributes.position.needsUpdate = true;
+      const coloured = surface.colours !== null;
+      if (coloured) {
+        geometry.attributes.color.array.set(surface.colours);
+        geometry.attributes.color.needsUpdate = true;
+      }
+      if (mesh.material.vertexColors !== coloured) {
+        mesh.material.vertexColors = coloured;
+        mesh.material.color.set(coloured ? 0xffffff : data.panels[i].color);
+        mesh.material.needsUpdate = true;
+      }
       geometry.computeVertexNormals();
       geometry.computeBoundingSphere();
     });
@@ -172,9 +195,9 @@ Quantisation QuantisationOf(const std::vector<ViewerFrame>& frames) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (const ViewerFrame& frame : frames) {
-    for (const Mesh* mesh : {&frame.input, &frame.refined}) {
-      low = low.cwiseMin(mesh->vertices.rowwise().minCoeff());
-      high = high.cwiseMax(mesh->vertices.rowwise().maxCoeff());
+    for (const ViewerSurface& surface : frame.surfaces) {
+      low = low.cwiseMin(surface.mesh.vertices.rowwise().minCoeff());
+      high = high.cwiseMax(surface.mesh.vertices.rowwise().maxCoeff());
     }
   }
   return {low, ((high - low) / kQuantisationLevels).cwiseMax(1e-12)};
@@ -191,6 +214,39 @@ std::string PositionsBase64(const Mesh& mesh, const Quantisation& box) {
     }
   }
   return Base64Of(positions);
+}
+
+// The vertex colours as RGB bytes, base64; empty when there are none.
+std::string ColorsBase64(const Eigen::Matrix3Xd& colors) {
+  std::vector<uint8_t> bytes(3 * colors.cols());
+  for (Eigen::Index v = 0; v < colors.cols(); ++v) {
+    for (int channel = 0; channel < 3; ++channel) {
+      const double value = std::isfinite(colors(channel, v)) ? colors(channel, v) : 0.5;
+      bytes[3 * v + channel] =
+          static_cast<uint8_t>(std::lround(255.0 * std::clamp(value, 0.0, 1.0)));
+    }
+  }
+  return Base64Of(bytes);
+}
+
+// The panels' labels over their parts of the canvas, then the canvas' end and the colour scales.
+std::string PanelMarkup(const std::vector<ViewerPanel>& panels) {
+  std::string markup;
+  const size_t count = panels.size();
+  for (size_t i = 0; i < count; ++i) {
+    markup += "<div class=\"viewer-label\" data-panel=\"" + EscapeHtml(panels[i].label) +
+              "\" style=\"position: absolute; top: 6px; left: calc(" +
+              std::to_string(100.0 * i / count) + "% + 10px); font-weight: bold;\">" +
+              EscapeHtml(panels[i].label) + "</div>\n";
+  }
+  markup += "</div>\n";
+  for (const ViewerPanel& panel : panels) {
+    if (panel.scale) {
+      markup += ColorScaleHtml(panel.label + ": " + panel.scale->title, 0.0, panel.scale->max_value,
+                               panel.scale->unit);
+    }
+  }
+  return markup;
 }
 
 std::string FacesBase64(const Mesh& mesh) {
@@ -266,31 +322,59 @@ std::vector<int> EvenlySpacedIndices(int count, int max_frames) {
   return indices;
 }
 
-std::string MeshViewerHtml(const std::vector<ViewerFrame>& frames, const Camera& camera,
+std::string MeshViewerHtml(const std::vector<ViewerPanel>& panels,
+                           const std::vector<ViewerFrame>& frames, const Camera& camera,
                            const ThreeJsLibrary& library) {
+  Require(!panels.empty(), "mesh viewer", "no panel to show");
   Require(!frames.empty(), "mesh viewer", "no frame to show");
-  const Mesh& first = frames.front().input;
+  Require(!frames.front().surfaces.empty(), "mesh viewer",
+          "frame " + frames.front().name + " has no surface");
+  const Mesh& first = frames.front().surfaces.front().mesh;
   for (const ViewerFrame& frame : frames) {
-    Require(HasSameTopology(frame.input, first) && HasSameTopology(frame.refined, first),
-            "mesh viewer", "frame " + frame.name + ": the meshes do not share one topology");
+    Require(frame.surfaces.size() == panels.size(), "mesh viewer",
+            "frame " + frame.name + " has " + std::to_string(frame.surfaces.size()) +
+                " surfaces for " + std::to_string(panels.size()) + " panels");
+    for (size_t p = 0; p < panels.size(); ++p) {
+      const ViewerSurface& surface = frame.surfaces[p];
+      Require(HasSameTopology(surface.mesh, first), "mesh viewer",
+              "frame " + frame.name + ", panel " + panels[p].label +
+                  ": the meshes do not share one topology");
+      Require(surface.vertex_colors.cols() == 0 ||
+                  surface.vertex_colors.cols() == surface.mesh.num_vertices(),
+              "mesh viewer",
+              "frame " + frame.name + ", panel " + panels[p].label + ": " +
+                  std::to_string(surface.vertex_colors.cols()) + " vertex colours for " +
+                  std::to_string(surface.mesh.num_vertices()) + " vertices");
+    }
   }
   const Quantisation box = QuantisationOf(frames);
   std::ostringstream data;
   data << "{\"faces\": \"" << FacesBase64(first) << "\", " << ViewJson(first, camera)
        << ", \"origin\": " << JsonVector(box.origin) << ", \"step\": " << JsonVector(box.step)
-       << ", \"frames\": [";
+       << ", \"panels\": [";
+  for (size_t p = 0; p < panels.size(); ++p) {
+    data << (p == 0 ? "" : ", ") << "{\"label\": " << internal::JsonString(panels[p].label)
+         << ", \"color\": " << (panels[p].color & 0xffffff) << "}";
+  }
+  data << "], \"frames\": [";
   for (size_t i = 0; i < frames.size(); ++i) {
     data << (i == 0 ? "" : ", ") << "{\"name\": " << internal::JsonString(frames[i].name)
-         << ", \"input\": \"" << PositionsBase64(frames[i].input, box) << "\", \"refined\": \""
-         << PositionsBase64(frames[i].refined, box) << "\"}";
+         << ", \"surfaces\": [";
+    for (size_t p = 0; p < frames[i].surfaces.size(); ++p) {
+      const ViewerSurface& surface = frames[i].surfaces[p];
+      data << (p == 0 ? "" : ", ") << "{\"positions\": \"" << PositionsBase64(surface.mesh, box)
+           << "\", \"colors\": \"" << ColorsBase64(surface.vertex_colors) << "\"}";
+    }
+    data << "]}";
   }
   data << "]}";
   std::string script = kViewerScript;
   const std::string placeholder = "FINECAP_VIEWER_DATA";
   script.replace(script.find(placeholder), placeholder.size(), data.str());
-  return std::string(kViewerMarkup) + "<script>" + ScriptSafe(library.three) + "</script>\n" +
-         "<script>" + ScriptSafe(library.orbit_controls) + "</script>\n<script>" +
-         ScriptSafe(script) + "</script>\n";
+  return std::string(kViewerMarkupStart) + PanelMarkup(panels) + kViewerMarkupEnd + "<script>" +
+         ScriptSafe(library.three) + "</script>\n" + "<script>" +
+         ScriptSafe(library.orbit_controls) + "</script>\n<script>" + ScriptSafe(script) +
+         "</script>\n";
 }
 
 std::string MissingViewerHtml() {

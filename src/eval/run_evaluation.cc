@@ -1,7 +1,9 @@
 #include "finecap/eval/run_evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <sstream>
 
@@ -179,6 +181,7 @@ struct EvaluationRun {
   FlowComparison pooled_flow;
   std::optional<RefinedFlowTexture> refined_flow_texture;  // None when flow is not measured.
   std::vector<internal::HeldOutFrame> heldout;  // Per frame; empty without validation.cameras.
+  std::vector<int> panel_frames;  // Frame indices whose held-out comparison panels are shown.
   EvaluationSamples pooled;
   std::vector<std::pair<std::string, std::string>> pictures;  // Path, caption.
   // The signed errors of the frame evaluated last, which the frame after it (index
@@ -218,7 +221,10 @@ void EvaluateFrame(const RefinedFrame& frame, const RunEvaluationOptions& option
   if (!options.held_out_cameras.empty()) {
     run->heldout.push_back(internal::EvaluateHeldOutFrame(
         options.held_out_cameras, options.held_out_score, frame.name,
-        ReadFrameInput(capture, frame.index), coarse, input, refined, eval_dir, &run->pictures));
+        ReadFrameInput(capture, frame.index), coarse, input, refined, eval_dir,
+        std::find(run->panel_frames.begin(), run->panel_frames.end(), frame.index) !=
+            run->panel_frames.end(),
+        &run->pictures));
   }
   const Camera& camera = capture->cameras()[options.camera];
   const cv::Mat image = capture->ReadImage(options.camera, frame.index);
@@ -475,33 +481,81 @@ void WriteFlowCsv(const EvaluationRun& run, const std::string& path) {
 }
 
 // Frames the report's 3D view offers: enough to see the motion, few enough to keep the report
-// small (each adds two meshes' positions).
+// small (each adds every panel's positions).
 constexpr int kViewerFrames = 5;
 
-// The report's 3D view: the input and refined meshes of up to kViewerFrames frames, evenly spaced
-// over the evaluated ones, seen first from the eval camera. Where three.js is absent a note takes
-// its place and a warning goes to stderr: the report is still written.
+// The report's 3D view of up to kViewerFrames frames, evenly spaced over the evaluated ones, seen
+// first from the eval camera: the subdivided input mesh, the refined mesh and, where the capture
+// has ground truth, the refined mesh coloured by |k - k_true| (the scale's top `error_scale`, the
+// sequence's 95th percentile of the input's error) and the true surface (the subdivided input
+// displaced by the true k along its normals, where the truth is known; the input elsewhere). Where
+// three.js is absent a note takes its place and a warning goes to stderr: the report is still
+// written.
 std::string ViewerHtml(const std::vector<RefinedFrame>& frames, const SequenceModel& model,
-                       const Camera& camera, Capture* capture, EvaluationObserver* observer) {
+                       const Camera& camera, double error_scale, Capture* capture,
+                       EvaluationObserver* observer) {
   const std::optional<ThreeJsLibrary> library = FindThreeJs();
   if (!library) {
     observer->ViewerUnavailable();
     return MissingViewerHtml();
   }
-  std::vector<ViewerFrame> shown;
-  for (int i : EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames)) {
-    const RefinedFrame& frame = frames[i];
-    shown.push_back({frame.name, model.Subdivide(capture->ReadCoarseMesh(frame.index)),
-                     ReadMesh(frame.files.mesh)});
+  const std::vector<int> shown_indices =
+      EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames);
+  // Truth is shown only when every shown frame has it, so that the panels stay the same.
+  bool with_truth = error_scale > 0.0;
+  for (int i : shown_indices) with_truth = with_truth && capture->HasTrueSurface(frames[i].index);
+  std::vector<ViewerPanel> panels = {{"input", 0xa9b4c4, std::nullopt}};
+  if (with_truth) {
+    panels.push_back({"refined, coloured by its error", 0xd9bc96,
+                      ViewerColorScale{"|k - k_true|", Millimetres(error_scale), "mm"}});
+    panels.push_back({"truth", 0xa8c4a2, std::nullopt});
+  } else {
+    panels.push_back({"refined", 0xd9bc96, std::nullopt});
   }
-  return MeshViewerHtml(shown, camera, *library);
+  std::vector<ViewerFrame> shown;
+  for (int i : shown_indices) {
+    const RefinedFrame& frame = frames[i];
+    const Mesh coarse = capture->ReadCoarseMesh(frame.index);
+    ViewerFrame viewed{frame.name,
+                       {{model.Subdivide(coarse), {}}, {ReadMesh(frame.files.mesh), {}}}};
+    if (with_truth) {
+      const Mesh& input = viewed.surfaces[0].mesh;
+      const Eigen::VectorXd k_true =
+          TrueFineGroundTruth(*capture, model, coarse, frame.index).k_true;
+      const Eigen::VectorXd k = ReadDisplacement(frame.files.displacement, input.num_vertices());
+      viewed.surfaces[1].vertex_colors = HeatMapColors((k - k_true).cwiseAbs(), error_scale);
+      Mesh truth = input;
+      const Eigen::Matrix3Xd normals = ComputeVertexNormals(input);
+      for (int v = 0; v < input.num_vertices(); ++v) {
+        if (v < k_true.size() && std::isfinite(k_true[v])) {
+          truth.vertices.col(v) += k_true[v] * normals.col(v);
+        }
+      }
+      viewed.surfaces.push_back({std::move(truth), {}});
+    }
+    shown.push_back(std::move(viewed));
+  }
+  return MeshViewerHtml(panels, shown, camera, *library);
 }
 
-void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
-                 const HeldOutOptions& heldout_options,
-                 const std::vector<std::pair<std::string, std::string>>& plots,
-                 const std::vector<std::pair<std::string, std::string>>& flow_plots,
-                 const std::string& viewer_html, const std::string& path) {
+// One section of the report: its heading and what fills it. The report is the list of its
+// sections (ReportSections), in order; a new kind of figure is one more entry there.
+struct ReportSection {
+  std::string heading;
+  std::function<void(HtmlReport*)> fill;
+};
+
+// What the report's sections are made of.
+struct ReportContent {
+  const EvaluationRun& run;
+  const EvaluationFigures& sequence;
+  const HeldOutOptions& heldout_options;
+  std::vector<std::pair<std::string, std::string>> plots;
+  std::vector<std::pair<std::string, std::string>> flow_plots;
+  std::string viewer_html;
+};
+
+void AddFiguresSection(const ReportContent& content, HtmlReport* report) {
   const std::vector<std::string> header = {"",
                                            "vertices",
                                            "RMS input mm",
@@ -518,9 +572,7 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
                                            "normal error input deg",
                                            "normal error subdivided deg",
                                            "normal error refined deg"};
-  HtmlReport report("finecap evaluation");
-  report.AddSection("Figures");
-  report.AddParagraph(
+  report->AddParagraph(
       "Distances to the ground truth along the normals of the subdivided input mesh, over the "
       "refined vertices, of the input as given (the coarse mesh's triangles sampled at the fine "
       "vertices), of its Loop subdivision (where refinement starts, k of 0) and of the refined "
@@ -530,25 +582,53 @@ void WriteReport(const EvaluationRun& run, const EvaluationFigures& sequence,
       "sequence is played; a steady error has none. True normals: the subdivided input mesh "
       "displaced by the true k. n/a: no ground truth, an empty region or, for the flicker, no "
       "frame before.");
-  report.AddTable(header,
-                  {TableRow("all", sequence.all), TableRow("textured", sequence.textured),
-                   TableRow("textureless", sequence.textureless)},
-                  "The whole sequence, vertices of all frames pooled");
+  const EvaluationFigures& sequence = content.sequence;
+  report->AddTable(header,
+                   {TableRow("all", sequence.all), TableRow("textured", sequence.textured),
+                    TableRow("textureless", sequence.textureless)},
+                   "The whole sequence, vertices of all frames pooled");
   std::vector<std::vector<TableCell>> frame_rows;
-  for (size_t i = 0; i < run.names.size(); ++i) {
-    frame_rows.push_back(TableRow(run.names[i], run.figures[i].all));
+  for (size_t i = 0; i < content.run.names.size(); ++i) {
+    frame_rows.push_back(TableRow(content.run.names[i], content.run.figures[i].all));
   }
-  report.AddTable(header, frame_rows, "Per frame, all refined vertices");
-  report.AddSection("3D view");
-  report.AddRawHtml(viewer_html);
-  report.AddSection("Optical flow");
-  AddFlowTable(run, &report);
-  for (const auto& [plot, caption] : flow_plots) report.AddImageFile(plot, caption);
-  if (!run.heldout.empty()) internal::AddHeldOutSection(run.heldout, heldout_options, &report);
-  if (!plots.empty()) report.AddSection("Over the frames");
-  for (const auto& [plot, caption] : plots) report.AddImageFile(plot, caption);
-  report.AddSection("Pictures");
-  for (const auto& [picture, caption] : run.pictures) report.AddImageFile(picture, caption);
+  report->AddTable(header, frame_rows, "Per frame, all refined vertices");
+}
+
+// The report's sections, top to bottom; a section with nothing to show is left out.
+std::vector<ReportSection> ReportSections(const ReportContent& content) {
+  std::vector<ReportSection> sections;
+  sections.push_back({"Figures", [&](HtmlReport* r) { AddFiguresSection(content, r); }});
+  sections.push_back({"3D view", [&](HtmlReport* r) { r->AddRawHtml(content.viewer_html); }});
+  if (!content.run.heldout.empty()) {
+    sections.push_back({"Held-out cameras", [&](HtmlReport* r) {
+                          internal::AddHeldOutSection(content.run.heldout, content.heldout_options,
+                                                      r);
+                        }});
+  }
+  sections.push_back({"Optical flow", [&](HtmlReport* r) {
+                        AddFlowTable(content.run, r);
+                        for (const auto& [plot, caption] : content.flow_plots)
+                          r->AddImageFile(plot, caption);
+                      }});
+  if (!content.plots.empty()) {
+    sections.push_back({"Over the frames", [&](HtmlReport* r) {
+                          for (const auto& [plot, caption] : content.plots)
+                            r->AddImageFile(plot, caption);
+                        }});
+  }
+  sections.push_back({"Pictures", [&](HtmlReport* r) {
+                        for (const auto& [picture, caption] : content.run.pictures)
+                          r->AddImageFile(picture, caption);
+                      }});
+  return sections;
+}
+
+void WriteReport(const ReportContent& content, const std::string& path) {
+  HtmlReport report("finecap evaluation");
+  for (const ReportSection& section : ReportSections(content)) {
+    report.AddSection(section.heading);
+    section.fill(&report);
+  }
   report.Write(path);
 }
 
@@ -596,6 +676,10 @@ RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& fra
   }
   EvaluationRun run;
   if (flow) run.refined_flow_texture = flow->refined_texture_source;
+  // The held-out comparison panels of the frames the 3D view shows.
+  for (int i : EvenlySpacedIndices(static_cast<int>(frames.size()), kViewerFrames)) {
+    run.panel_frames.push_back(frames[i].index);
+  }
   for (const RefinedFrame& frame : frames) {
     EvaluateFrame(frame, options, model, textureless, flow ? &*flow : nullptr, folder, capture,
                   &run);
@@ -611,9 +695,10 @@ RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& fra
   result.report = folder + "/report.html";
   WriteTextFileAtomically(result.metrics, MetricsJson(run, result.sequence));
   WriteFlowCsv(run, folder + "/flow.csv");
-  WriteReport(run, result.sequence, options.held_out_score, WritePlots(run, folder),
-              WriteFlowPlot(run, folder),
-              ViewerHtml(frames, model, capture->cameras()[options.camera], capture, observer),
+  WriteReport({run, result.sequence, options.held_out_score, WritePlots(run, folder),
+               WriteFlowPlot(run, folder),
+               ViewerHtml(frames, model, capture->cameras()[options.camera],
+                          result.sequence.all.coarse.p95_abs, capture, observer)},
               result.report);
   return result;
 }
