@@ -43,7 +43,8 @@ echo "demo:   with configs/demo.yaml: similarity $(json_value similarity "$stats
 printf 'demo: RMS error against the truth %.3f mm as given -> %.3f mm refined:' \
   "$(json_value rms_coarse_mm "$metrics")" "$(json_value rms_refined_mm "$metrics")"
 awk -v r="$recovered" 'BEGIN { printf " %.1f %% of the detail recovered\n", 100 * r }'
-echo "demo: open the report (figures, 3D view of input, refined and truth, held-out views, pictures):"
+echo "demo: open the report (figures; 3D view of the input, the refined mesh coloured by its error and"
+echo "demo:   the truth; plots; pictures):"
 echo "  $PWD/out/demo/eval/report.html"
 echo "demo: the image | normals of the input | normals refined, the detail added:"
 echo "  $PWD/$normals"

@@ -32,7 +32,7 @@ figure img { max-width: 100%; border: 1px solid #ddd; }
 figcaption { color: #555; font-size: 0.9em; }
 nav.contents { font-size: 0.95em; }
 nav.contents a { margin-right: 1.2em; }
-figure.panels > div.row { display: flex; flex-wrap: wrap; gap: 6px; align-items: flex-start; }
+figure.panels > div.row { display: flex; flex-wrap: wrap; gap: 6px; align-items: flex-end; }
 figure.panels div.panel { flex: 1 1 0; min-width: 120px; text-align: center; }
 figure.panels div.panel div { font-size: 0.85em; font-weight: bold; color: #334; }
 figure.panels div.panel img { width: 100%; image-rendering: pixelated; }

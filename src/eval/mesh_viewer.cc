@@ -123,9 +123,11 @@ constexpr char kViewerScript[] = R"js(
     renderer.setScissorTest(true);
     meshes.forEach((shown, index) => {
       meshes.forEach(mesh => { mesh.visible = mesh === shown; });
-      // Whole pixels, each part starting where the one before ends: no column left undrawn.
-      const left = Math.round(index * width / meshes.length);
-      const right = Math.round((index + 1) * width / meshes.length);
+      // Whole device pixels, each part starting where the one before ends: no column left
+      // undrawn at any pixel ratio.
+      const ratio = renderer.getPixelRatio();
+      const left = Math.round(index * width * ratio / meshes.length) / ratio;
+      const right = Math.round((index + 1) * width * ratio / meshes.length) / ratio;
       renderer.setViewport(left, 0, right - left, height);
       renderer.setScissor(left, 0, right - left, height);
       renderer.render(scene, camera);
