@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "eval/mesh_viewer.h"
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
 #include "finecap/refine/frame_stats.h"
@@ -239,7 +240,28 @@ TEST(HeldOutRefineTest, EvalWritesHeldOutFiguresAndPictures) {
   const cv::Mat picture = cv::imread(root + "/run/eval/heldout_000000_cam03.png");
   ASSERT_FALSE(picture.empty());
   EXPECT_GT(picture.cols, 4 * picture.rows / 2);  // Five panels side by side.
-  EXPECT_NE(FileBytes(root + "/run/eval/report.html").find("Held-out cameras"), std::string::npos);
+  const std::string report = FileBytes(root + "/run/eval/report.html");
+  EXPECT_NE(report.find("Held-out cameras"), std::string::npos);
+  // The comparison panels: the photo, what each mesh predicts there, their NCC maps.
+  EXPECT_NE(report.find("data-panels=\"held-out frame 000000, cam03\""), std::string::npos);
+  for (const std::string panel :
+       {"photo (held out)", "predicted by the input", "predicted by the refined mesh",
+        "NCC of the input", "NCC of the refined mesh"}) {
+    EXPECT_NE(report.find("data-panel=\"" + panel + "\""), std::string::npos) << panel;
+  }
+  EXPECT_NE(report.find("RMS subdivided mm"), std::string::npos);
+  if (FindThreeJs()) {
+    EXPECT_NE(report.find("data-panel=\"truth\""), std::string::npos);
+  }
+
+  // Without ground truth: no truth panel, no tables of n/a, the held-out comparisons still there.
+  fs::remove_all(capture + "/gt");
+  ASSERT_EQ(RunEval(config), 0);
+  const std::string without = FileBytes(root + "/run/eval/report.html");
+  EXPECT_NE(without.find("No ground truth"), std::string::npos);
+  EXPECT_EQ(without.find("RMS subdivided mm"), std::string::npos);
+  EXPECT_EQ(without.find("data-panel=\"truth\""), std::string::npos);
+  EXPECT_NE(without.find("data-panel=\"NCC of the refined mesh\""), std::string::npos);
 }
 
 TEST(HeldOutRefineTest, RefusesUnknownAndAllHeldOutCameras) {

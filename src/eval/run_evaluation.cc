@@ -597,7 +597,18 @@ void AddFiguresSection(const ReportContent& content, HtmlReport* report) {
 // The report's sections, top to bottom; a section with nothing to show is left out.
 std::vector<ReportSection> ReportSections(const ReportContent& content) {
   std::vector<ReportSection> sections;
-  sections.push_back({"Figures", [&](HtmlReport* r) { AddFiguresSection(content, r); }});
+  if (content.sequence.all.refined.count > 0) {
+    sections.push_back({"Figures", [&](HtmlReport* r) { AddFiguresSection(content, r); }});
+  } else {
+    // Tables of n/a would say less than this.
+    sections.push_back({"Figures", [](HtmlReport* r) {
+                          r->AddParagraph(
+                              "No ground truth: the capture has no true surface for the evaluated "
+                              "frames, so no error against it is measured. The held-out cameras "
+                              "(validation.cameras) and the optical flow measure the result "
+                              "without one.");
+                        }});
+  }
   sections.push_back({"3D view", [&](HtmlReport* r) { r->AddRawHtml(content.viewer_html); }});
   if (!content.run.heldout.empty()) {
     sections.push_back({"Held-out cameras", [&](HtmlReport* r) {
