@@ -11,9 +11,12 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include "eval/mesh_viewer.h"
 #include "finecap/commands/commands.h"
 #include "finecap/config/config.h"
+#include "finecap/eval/html_report.h"
 #include "finecap/synth/synth.h"
 #include "test_util.h"
 #include "tiny_synth.h"
@@ -60,6 +63,32 @@ TEST(ReportViewerTest, ChromiumShowsTruthAndHeldOutComparisons) {
       EXPECT_NE(line.find(panel), std::string::npos) << line;
     }
   }
+}
+
+// The check itself fails on a blank comparison panel (a picture of one colour), naming it.
+TEST(ReportViewerTest, CheckFailsOnABlankPanel) {
+  const std::string root = testing_util::MakeTempDir("report_blank_panel");
+  cv::Mat texture(32, 32, CV_8UC3);
+  cv::randu(texture, cv::Scalar::all(0), cv::Scalar::all(255));
+  HtmlReport report("blank panel");
+  report.AddSection("Held-out cameras");
+  report.AddPanelRow(
+      "held-out frame 000000, cam01",
+      {{"photo (held out)", texture},
+       {"predicted by the refined mesh", cv::Mat(32, 32, CV_8UC3, cv::Scalar(9, 9, 9))}});
+  report.Write(root + "/report.html");
+  const std::string command = "bash " FINECAP_SOURCE_DIR "/scripts/check-report.sh " + root +
+                              "/report.html " + root + "/shot.png > " + root + "/check.log 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << command;
+  const std::string log = testing_util::FileBytes(root + "/check.log");
+  if (WEXITSTATUS(status) == kChromiumUnavailable) GTEST_SKIP() << log;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << log;
+  EXPECT_NE(log.find("panel 'predicted by the refined mesh' of 'held-out frame 000000, cam01' is "
+                     "blank (1 colours)"),
+            std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("panel 'photo (held out)'"), std::string::npos) << log;
 }
 
 }  // namespace
