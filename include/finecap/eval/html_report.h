@@ -84,8 +84,8 @@ class HtmlReport {
   // Pictures side by side, each under its label, with one caption under the row: the same view
   // seen in several ways (a photo beside what two meshes predict of it). The row is marked
   // `class="panels" data-panels="<name>"` and each picture `data-panel="<label>"`, so that a
-  // browser test can find them. Throws Error when `panels` is empty or a picture is empty or of
-  // a type AddImage refuses.
+  // browser test can find them. Throws Error when `panels` is empty or a picture is empty or not
+  // 8-bit grey or BGR.
   void AddPanelRow(const std::string& name, const std::vector<ReportPanel>& panels,
                    const std::string& caption = "");
   // Inserts `html` as it is, not escaped: for generated fragments such as the 3D viewer
