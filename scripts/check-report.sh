@@ -270,7 +270,7 @@ check_panels() {
         problems=1
       fi
     done < <(tr ',' '\n' <<<"${row#*: }")
-  done < <(sed 's/; /\n/g' <<<"$rows")
+  done <<<"${rows//; /$'\n'}"
   return $problems
 }
 
