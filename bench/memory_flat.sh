@@ -18,7 +18,7 @@ trap 'rm -rf "$work"' EXIT
 build/finecap synth --config configs/synth_long.yaml --out "$work/capture" \
   --set "synth.num_frames=$frames" >/dev/null
 start=$(date +%s.%N)
-# 4 cameras 90 degrees apart: 50 degrees leaves no point unseen (as configs/demo.yaml).
+# 4 cameras 90 degrees apart: 50 degrees leaves no point unseen.
 build/finecap refine --capture "$work/capture" --out "$work/run" \
   --set visibility.max_view_angle_deg=50 >/dev/null 2>&1
 end=$(date +%s.%N)
