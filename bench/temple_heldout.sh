@@ -5,6 +5,7 @@
 # MAD of the visual hull as given (input), of its subdivision and of the refined mesh.
 #
 #   bash bench/temple_heldout.sh            # CAPTURE=DIR for a copy elsewhere; OUT=DIR keeps the run
+#   SET="energy.confidence_prior=0" bash bench/temple_heldout.sh   # extra settings (--set)
 #
 # Prints one "name: value" a line: per held-out view heldout_ncc_input/subdivided/refined and
 # heldout_mad_input/subdivided/refined, the same over all views, refine_worse (the frame's flag),
@@ -24,7 +25,8 @@ rm -rf "$work/run"
 
 [ -x build/finecap ] || bash scripts/build.sh >/dev/null
 args=(--config configs/temple.yaml --capture "$capture" --out "$work/run")
-/usr/bin/time -f "%e %M" -o "$work/refine.time" build/finecap refine "${args[@]}" >/dev/null
+/usr/bin/time -f "%e %M" -o "$work/refine.time" build/finecap refine "${args[@]}" \
+  --set "${SET:-}" >/dev/null
 start=$(date +%s.%N)
 build/finecap eval "${args[@]}" --set eval.flow=none >/dev/null
 end=$(date +%s.%N)

@@ -188,13 +188,37 @@ TEST(CliTest, RefineRefusesARunForecastAboveTheMemoryLimit) {
   EXPECT_TRUE(fs::exists(out / "stats.jsonl"));
 }
 
+// Refine's summary states the share of vertices refined with confidence, and says so when a
+// capture cannot be refined usefully: three cameras 120 degrees apart never give a point a third
+// camera within the fallback view angle, so asking for three leaves no vertex with confidence. The
+// run still succeeds.
+TEST(CliTest, RefineSaysHowMuchItRefinedWithConfidence) {
+  const fs::path capture = TinyCapture("confidence");
+  const std::string out = (FreshFolder("confidence") / "out").string();
+  const RunResult usual = RunFinecap("refine --capture " + capture.string() + " --out " + out +
+                                     "_usual --set solver.max_iterations=2");
+  EXPECT_EQ(usual.exit_code, 0) << usual.output;
+  EXPECT_NE(usual.output.find("Refined with confidence: "), std::string::npos) << usual.output;
+
+  const RunResult starved =
+      RunFinecap("refine --capture " + capture.string() + " --out " + out +
+                 "_starved --set solver.max_iterations=2,energy.consensus.min_cameras=3");
+  EXPECT_EQ(starved.exit_code, 0) << starved.output;
+  EXPECT_NE(starved.output.find("Refined with confidence: 0 %"), std::string::npos)
+      << starved.output;
+  EXPECT_NE(starved.output.find("Too few views for this capture to be refined usefully"),
+            std::string::npos)
+      << starved.output;
+}
+
 TEST(CliTest, InfoWarnsAboutVerticesNoCameraSees) {
   const fs::path capture = TinyCapture("info_unseen");
   const RunResult result =
-      RunFinecap("info --capture " + capture.string() + " --set visibility.max_view_angle_deg=1");
+      RunFinecap("info --capture " + capture.string() +
+                 " --set visibility.max_view_angle_deg=1,visibility.fallback_view_angle_deg=2");
   EXPECT_EQ(result.exit_code, 0) << result.output;
   EXPECT_NE(result.output.find("warning: "), std::string::npos) << result.output;
-  EXPECT_NE(result.output.find("seen by no camera within visibility.max_view_angle_deg 1"),
+  EXPECT_NE(result.output.find("seen by no camera within visibility.fallback_view_angle_deg 2"),
             std::string::npos)
       << result.output;
 }

@@ -122,8 +122,9 @@ TEST(HostileGeometry, VerticesSeenByNoCameraGetNoGaussian) {
   ExpectFiniteResult(result);
   // Exactly the vertices that the camera sees on the input surface have a displacement.
   const Mesh fine = SequenceModel(input.coarse, {}, FastOptions(), "test").Subdivide(input.coarse);
-  const auto visible = ComputeFrameVisibility(fine, ComputeVertexNormals(fine), input.cameras,
-                                              FastOptions().visibility);
+  const auto visible =
+      ComputeFrameVisibility(fine, ComputeVertexNormals(fine), input.cameras,
+                             FastOptions().visibility, FallbackCamerasWanted(FastOptions()));
   int unseen = 0;
   for (int v = 0; v < result.k.size(); ++v) {
     EXPECT_EQ(std::isnan(result.k[v]), visible[0][v] == 0) << v;

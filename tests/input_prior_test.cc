@@ -120,11 +120,15 @@ TEST(PriorCurvatureTest, AddsTheUniformPullAndTheScaledConfidencePull) {
   options.reg_unit = RegUnit::kMillimetres;
   options.confidence_prior = 10.0;
   const Eigen::VectorXd data = (Eigen::VectorXd(5) << 4.0, 0.0, 1.0, 3.0, 2.0).finished();
-  const Eigen::VectorXd plain = (Eigen::VectorXd(5) << 1.0, 0.0, 0.5, 0.0, 1.0).finished();
-  const Eigen::VectorXd prior = PriorCurvature(data, plain, 5, options);
-  // Median of the positive data curvatures {1, 2, 3, 4}: the upper middle one, 3.
+  const Eigen::VectorXd confidence = (Eigen::VectorXd(5) << 0.0, 1.0, 0.5, 1.0, 0.0).finished();
+  const Eigen::VectorXd prior = PriorCurvature(data, confidence, 5, options);
+  // Median of the positive data curvatures {1, 2, 3, 4}: the upper middle one, 3; the pull goes
+  // with the square of the doubt, 1 - c.
   const double uniform = 2.0 * 2.0 * 1e6;
-  for (int s = 0; s < 5; ++s) EXPECT_DOUBLE_EQ(prior[s], uniform + 10.0 * 3.0 * plain[s]);
+  const double doubt_squared[5] = {1.0, 0.0, 0.25, 0.0, 1.0};
+  for (int s = 0; s < 5; ++s) {
+    EXPECT_DOUBLE_EQ(prior[s], uniform + 10.0 * 3.0 * doubt_squared[s]);
+  }
 
   options.confidence_prior = 0.0;
   EXPECT_EQ(PriorCurvature({}, {}, 3, options), Eigen::VectorXd::Constant(3, uniform));

@@ -92,6 +92,7 @@ TEST_F(ProblemSizeTest, MoreReachMeansMorePairsAndMoreMemory) {
 TEST_F(ProblemSizeTest, VerticesNoCameraSeesAreCounted) {
   RefineOptions narrow = options_;
   narrow.visibility.max_view_angle_deg = 1.0;
+  narrow.visibility.fallback_view_angle_deg = 1.0;
   PreparedFrame prepared;
   const ProblemSize size = Estimate(narrow, &prepared);
   EXPECT_GT(size.num_unseen_refined_vertices, 0);

@@ -1,5 +1,6 @@
 #include "finecap/model/surface_gaussians.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -56,6 +57,56 @@ TEST(MostFrontalCameraTest, PicksTheCameraFacingTheNormalAmongThoseThatSeeThePoi
   EXPECT_EQ(MostFrontalCamera(point, normal, cameras, [](int) { return false; }), -1);
   // Facing away from every camera still picks the least oblique of those that see it.
   EXPECT_EQ(MostFrontalCamera(point, -3.0 * normal, cameras, all), 2);
+}
+
+// A point at the origin facing the first of three cameras at 0, 1.2 and 1.45 radians about it (0,
+// 68.8 and 83.1 degrees from its normal), all of which see it within the fallback angle.
+class FrontalViewsTest : public ::testing::Test {
+ protected:
+  FrontalViewsTest()
+      : cameras_({LookAtOrigin(1.0, 0.0, 400.0, 100), LookAtOrigin(1.0, 1.2, 400.0, 100),
+                  LookAtOrigin(1.0, 1.45, 400.0, 100)}),
+        points_(Eigen::Matrix3Xd::Zero(3, 1)),
+        normals_(Eigen::Vector3d(0.0, 0.0, -1.0)) {}
+
+  // Which cameras keep the point when it wants `wanted`.
+  std::vector<int> Kept(int wanted) const {
+    std::vector<std::vector<unsigned char>> visible(3, std::vector<unsigned char>(1, 1));
+    KeepFrontalViews(cameras_, points_, normals_, wanted, options_, &visible);
+    std::vector<int> kept;
+    for (int c = 0; c < 3; ++c) {
+      if (visible[c][0]) kept.push_back(c);
+    }
+    return kept;
+  }
+  float Confidence(int wanted, std::vector<unsigned char> seen_by = {1, 1, 1}) const {
+    std::vector<std::vector<unsigned char>> visible;
+    for (unsigned char seen : seen_by) visible.push_back({seen});
+    return ViewConfidence(cameras_, points_, normals_, wanted, options_, visible)[0];
+  }
+
+  std::vector<Camera> cameras_;
+  Eigen::Matrix3Xd points_, normals_;
+  VisibilityOptions options_;  // Within 60 degrees, and up to 85 for a point short of cameras.
+};
+
+TEST_F(FrontalViewsTest, APointShortOfCamerasTakesTheMostFrontalOthers) {
+  EXPECT_EQ(Kept(0), std::vector<int>({0}));
+  EXPECT_EQ(Kept(1), std::vector<int>({0}));
+  EXPECT_EQ(Kept(2), std::vector<int>({0, 1}));
+  EXPECT_EQ(Kept(3), std::vector<int>({0, 1, 2}));
+}
+
+TEST_F(FrontalViewsTest, ConfidenceFollowsTheWantedCamerasAngle) {
+  const double full = std::cos(60.0 * M_PI / 180.0), none = std::cos(85.0 * M_PI / 180.0);
+  EXPECT_FLOAT_EQ(Confidence(1), 1.0f);
+  EXPECT_FLOAT_EQ(Confidence(2), static_cast<float>((std::cos(1.2) - none) / (full - none)));
+  EXPECT_FLOAT_EQ(Confidence(3), static_cast<float>((std::cos(1.45) - none) / (full - none)));
+  EXPECT_FLOAT_EQ(Confidence(2, {1, 0, 0}), 0.0f) << "one camera where two are wanted";
+  EXPECT_FLOAT_EQ(Confidence(1, {0, 0, 1}),
+                  static_cast<float>((std::cos(1.45) - none) / (full - none)));
+  options_.fallback_view_angle_deg = options_.max_view_angle_deg;
+  EXPECT_FLOAT_EQ(Confidence(2), 0.0f) << "no fallback: a view beyond the cap counts for nothing";
 }
 
 TEST(ReferenceColorsTest, WrongVertexCountAndTruncationAreNamed) {

@@ -198,6 +198,9 @@ class ConsoleObserver : public SequenceObserver {
       detail << ", flicker " << stats.flicker_subdivided_mm << " -> " << stats.flicker_refined_mm
              << " mm";
     }
+    if (std::isfinite(stats.confident_share)) {
+      detail << ", " << std::lround(100.0 * stats.confident_share) << " % confident";
+    }
     progress_.FrameDone(stats.frame, false, detail.str());
   }
 
@@ -205,6 +208,27 @@ class ConsoleObserver : public SequenceObserver {
   std::string command_;
   Progress progress_;
 };
+
+}  // namespace
+
+namespace {
+
+// Below this share of vertices refined with confidence, a run says that its capture cannot be
+// refined usefully: most of the surface then stays near the input, for want of views.
+constexpr double kUsefulConfidentShare = 0.5;
+
+void PrintConfidence(double confident_share) {
+  if (!std::isfinite(confident_share)) return;
+  const long percent = std::lround(100.0 * confident_share);
+  std::cout << "Refined with confidence: " << percent
+            << " % of the refined vertices (mean over the frames run now); the rest, seen by too "
+               "few cameras, only at steep angles, or plain, stay near the input\n";
+  if (confident_share < kUsefulConfidentShare) {
+    std::cout << "Too few views for this capture to be refined usefully: only " << percent
+              << " % of its surface is seen well enough by enough cameras (visibility.*, "
+                 "energy.consensus.min_cameras); the rest is kept near the input\n";
+  }
+}
 
 }  // namespace
 
@@ -232,6 +256,7 @@ void RefineConfiguredSequence(const Config& config, const FrameRange& frames,
   }
   std::cout << "Refined meshes: " << out << "/meshes/, displacements: " << out
             << "/k/, statistics: " << out << "/stats.jsonl\n";
+  PrintConfidence(result.confident_share);
   if (result.measured > 0) {
     std::cout.precision(3);
     std::cout << "Error against the ground truth (textured region, RMS over the frames run now): "

@@ -48,10 +48,13 @@ void PrintWarnings(const Config& config, const std::vector<Camera>& training,
                  "beyond the view-angle cap): check its calibration and units\n";
   }
   if (size.num_unseen_refined_vertices > 0) {
+    const VisibilityOptions& visibility = config.refine.visibility;
+    const bool fallback = FallbackCamerasWanted(config.refine) > 0;
     std::cout << "warning: " << size.num_unseen_refined_vertices << " of "
-              << size.num_refined_vertices
-              << " vertices to refine are seen by no camera within visibility.max_view_angle_deg "
-              << config.refine.visibility.max_view_angle_deg
+              << size.num_refined_vertices << " vertices to refine are seen by no camera within "
+              << (fallback ? "visibility.fallback_view_angle_deg "
+                           : "visibility.max_view_angle_deg ")
+              << (fallback ? visibility.fallback_view_angle_deg : visibility.max_view_angle_deg)
               << " degrees; they keep the input surface\n";
   }
 }

@@ -198,6 +198,12 @@ void AddModelKeys(Config* config, ConfigSchema* schema) {
   schema->AddDouble("visibility.max_view_angle_deg", &refine.visibility.max_view_angle_deg,
                     "Largest angle between a normal and the direction to a camera that sees it.",
                     1.0, 90.0);
+  schema->AddDouble("visibility.fallback_view_angle_deg",
+                    &refine.visibility.fallback_view_angle_deg,
+                    "A vertex that fewer cameras see within max_view_angle_deg than the "
+                    "similarity compares takes the most frontal up to this angle, with less "
+                    "confidence; equal to max_view_angle_deg: none.",
+                    1.0, 90.0);
   schema->AddDouble("visibility.border_margin", &refine.visibility.border_margin,
                     "Vertices projecting closer than this to the image border are not used, px.",
                     0.0, 1000.0);
@@ -266,8 +272,9 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                     "textureless regions in place.",
                     0.0, 1e12);
   schema->AddDouble("energy.confidence_prior", &energy->confidence_prior,
-                    "Strength of a pull of k towards the input surface on wide plain regions of "
-                    "the cloth, in units of the median data curvature (not in the paper; 0: off).",
+                    "Strength of a pull of k towards the input surface where the images cannot "
+                    "decide it (few cameras, steep views, wide plain regions), in units of the "
+                    "median data curvature (not in the paper; 0: off).",
                     0.0, 1e6);
   schema->AddDouble("energy.confidence_threshold", &energy->confidence_threshold,
                     "Colour variation, as a fraction of its median, below which the cloth counts "

@@ -100,12 +100,12 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
                    options_.RegUnitScale()) {
   // The data curvature is measured once, at the input surface, so that the prior is a fixed
   // quadratic: the solvers see one energy throughout.
-  Eigen::VectorXd data_curvature, plain_cloth;
+  confidence_ = Confidence(surface_, PlainCloth(surface_, regularizer_, options_));
+  Eigen::VectorXd data_curvature;
   if (options_.confidence_prior > 0.0) {
     data_curvature = DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size()));
-    plain_cloth = PlainCloth(surface_, regularizer_, options_);
   }
-  prior_curvature_ = PriorCurvature(data_curvature, plain_cloth, surface_.size(), options_);
+  prior_curvature_ = PriorCurvature(data_curvature, confidence_, surface_.size(), options_);
   for (EnergyView& view : views_) {
     num_pairs_ += view.pairs.num_pairs();
     if (similarity_->ReadsPairLists()) continue;

@@ -5,10 +5,11 @@
 // with a curvature p_s per surface Gaussian. Where a plain cloth shows no texture, the colour
 // residuals do not change with k_s and only the regulariser decides it: it carries the
 // displacement of the textured surroundings into the plain region, which can be worse than the
-// input. A uniform pull (energy.w_prior) prevents that but costs detail wherever the images do
-// constrain k. The confidence pull (energy.confidence_prior) holds only Gaussians on wide plain
-// regions of the cloth, found from the reference colours, with a strength in the units of the
-// data's own curvature.
+// input. So can steep views, and too few cameras: on a sparse rig much of the surface is seen
+// well by one camera only. A uniform pull (energy.w_prior) prevents that but costs detail
+// wherever the images do constrain k. The confidence pull (energy.confidence_prior) holds each
+// Gaussian by how little the images decide it (Confidence: the views that see it, the texture
+// around it), with a strength in the units of the data's own curvature.
 #ifndef FINECAP_INPUT_PRIOR_H_
 #define FINECAP_INPUT_PRIOR_H_
 
@@ -40,11 +41,20 @@ Eigen::VectorXd ColorVariation(const SurfaceGaussians& surface, const Regularize
 Eigen::VectorXd PlainCloth(const SurfaceGaussians& surface, const Regularizer& regularizer,
                            const EnergyOptions& options);
 
-// p_s = 2 w_prior u^2 + mu H P_s: the uniform pull and the confidence pull, with u the unit scale
-// of E_reg, mu = confidence_prior, H the median of the positive data curvatures (it gives the
-// pull the data's units) and P_s = `plain_cloth`. Both vectors may be empty when mu is 0.
+// The confidence c_s in [0, 1] that the images decide k_s, from the training images alone: how
+// well the cameras the similarity needs see the Gaussian (SurfaceGaussians::view_confidence: how
+// many, at what angles) times how textured the cloth around it is (1 - `plain_cloth`). A Gaussian
+// with c_s >= 1/2 is refined with confidence. How peaked the cost is at the input (the data
+// curvature) is left out: a Gaussian no patch covers is already one that too few cameras see,
+// and the regulariser carries the detail of its surroundings into it, which a real capture's
+// held-out views preferred (docs/measurements.md, 2026-12-05).
+Eigen::VectorXd Confidence(const SurfaceGaussians& surface, const Eigen::VectorXd& plain_cloth);
+
+// p_s = 2 w_prior u^2 + mu H (1 - c_s)^2: the uniform pull and the confidence pull, with u the
+// unit scale of E_reg, mu = confidence_prior, H the median of the positive data curvatures (it
+// gives the pull the data's units) and c_s = `confidence`. Both vectors may be empty when mu is 0.
 Eigen::VectorXd PriorCurvature(const Eigen::VectorXd& data_curvature,
-                               const Eigen::VectorXd& plain_cloth, int num_parameters,
+                               const Eigen::VectorXd& confidence, int num_parameters,
                                const EnergyOptions& options);
 
 }  // namespace finecap

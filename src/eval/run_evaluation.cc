@@ -119,7 +119,7 @@ ProjectiveTexture TextureFromSurface(const Mesh& mesh, const FrameInput& referen
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(mesh);
   return MakeProjectiveTexture(
       mesh, normals, reference.cameras, reference.images,
-      ComputeFrameVisibility(mesh, normals, reference.cameras, visibility));
+      ComputeFrameVisibility(mesh, normals, reference.cameras, visibility, 0));
 }
 
 // The textures of the reference frame's subdivided input mesh and of its refined mesh (when

@@ -1,6 +1,8 @@
 #include "finecap/model/visibility.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "finecap/util/error.h"
 #include "util/option_checks.h"
@@ -11,6 +13,8 @@ void VisibilityOptions::Check() const {
   internal::RequireFieldRange(depth_tolerance, 0.0, 10.0, "VisibilityOptions::depth_tolerance");
   internal::RequireFieldRange(max_view_angle_deg, 1.0, 90.0,
                               "VisibilityOptions::max_view_angle_deg");
+  internal::RequireFieldRange(fallback_view_angle_deg, max_view_angle_deg, 90.0,
+                              "VisibilityOptions::fallback_view_angle_deg");
   internal::RequireFieldRange(border_margin, 0.0, 1000.0, "VisibilityOptions::border_margin");
 }
 
@@ -59,6 +63,66 @@ std::vector<unsigned char> ComputeVisibility(const Camera& camera, const cv::Mat
     visible[p] = depth <= NearestRenderedDepth(depth_map, pixel) + options.depth_tolerance;
   }
   return visible;
+}
+
+namespace {
+
+double CosineOf(double degrees) { return std::cos(degrees * M_PI / 180.0); }
+
+// The cosines of the angles at which the cameras that `visible` marks see point p, largest
+// first, with the cameras.
+std::vector<std::pair<double, int>> ViewsOf(const std::vector<Camera>& cameras,
+                                            const Eigen::Vector3d& point,
+                                            const Eigen::Vector3d& normal,
+                                            const std::vector<std::vector<unsigned char>>& visible,
+                                            int p) {
+  std::vector<std::pair<double, int>> views;
+  for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
+    if (!visible[c][p]) continue;
+    views.emplace_back(normal.dot((cameras[c].Center() - point).normalized()), c);
+  }
+  std::sort(views.begin(), views.end(), std::greater<>());
+  return views;
+}
+
+}  // namespace
+
+void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
+                      const Eigen::Matrix3Xd& normals, int wanted, const VisibilityOptions& options,
+                      std::vector<std::vector<unsigned char>>* visible) {
+  Require(visible->size() == cameras.size(), "KeepFrontalViews", "one flag list per camera");
+  const double min_cosine = CosineOf(options.max_view_angle_deg);
+  const int n = static_cast<int>(points.cols());
+#pragma omp parallel for schedule(static)
+  for (int p = 0; p < n; ++p) {
+    const auto views = ViewsOf(cameras, points.col(p), normals.col(p), *visible, p);
+    for (int i = 0; i < static_cast<int>(views.size()); ++i) {
+      if (views[i].first < min_cosine && i >= wanted) (*visible)[views[i].second][p] = 0;
+    }
+  }
+}
+
+std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
+                                  const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
+                                  int wanted, const VisibilityOptions& options,
+                                  const std::vector<std::vector<unsigned char>>& visible) {
+  Require(wanted >= 1 && visible.size() == cameras.size(), "ViewConfidence",
+          "at least one wanted camera and one flag list per camera");
+  const double full = CosineOf(options.max_view_angle_deg);
+  const double none = CosineOf(options.fallback_view_angle_deg);
+  const int n = static_cast<int>(points.cols());
+  std::vector<float> confidence(n, 0.0f);
+#pragma omp parallel for schedule(static)
+  for (int p = 0; p < n; ++p) {
+    const auto views = ViewsOf(cameras, points.col(p), normals.col(p), visible, p);
+    if (static_cast<int>(views.size()) < wanted) continue;
+    const double cosine = views[wanted - 1].first;
+    confidence[p] = cosine >= full ? 1.0f
+                    : full > none
+                        ? static_cast<float>(std::max(0.0, (cosine - none) / (full - none)))
+                        : 0.0f;
+  }
+  return confidence;
 }
 
 }  // namespace finecap

@@ -56,6 +56,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.seconds_linear_solver = summary.seconds_linear_solver;
   stats.seconds_similarity = summary.seconds_similarity;
   stats.surface_gaussians = result.num_surface_gaussians;
+  stats.confident_share = ConfidentShare(result);
   stats.image_gaussians = result.num_image_gaussians;
   stats.pairs = result.num_pairs;
   stats.worse = result.worse;
@@ -88,6 +89,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"seconds_heldout\": " << JsonNumber(s.seconds_heldout)
        << ", \"cpu_seconds\": " << JsonNumber(s.cpu_seconds)
        << ", \"surface_gaussians\": " << s.surface_gaussians
+       << ", \"confident_share\": " << JsonNumber(s.confident_share)
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
        << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
@@ -140,6 +142,7 @@ struct StatsFields {
       {"seconds_similarity", &FrameStats::seconds_similarity},
       {"seconds_heldout", &FrameStats::seconds_heldout},
       {"cpu_seconds", &FrameStats::cpu_seconds},
+      {"confident_share", &FrameStats::confident_share},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_subdivided_mm", &FrameStats::rms_subdivided_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},

@@ -117,8 +117,8 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   ProblemSize size;
   const Mesh fine = model.Subdivide(frame.coarse);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible =
-      ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility, frame.masks);
+  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility,
+                                              FallbackCamerasWanted(options), frame.masks);
   size.num_fine_vertices = fine.num_vertices();
   size.num_refined_vertices = static_cast<int>(model.refined_vertices().size());
   for (int v : model.refined_vertices()) {

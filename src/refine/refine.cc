@@ -116,20 +116,33 @@ Mesh SequenceModel::Interpolate(const Mesh& coarse) const {
   return ApplyLinearSubdivision(stencil_, coarse.vertices);
 }
 
-std::vector<std::vector<unsigned char>> ComputeFrameVisibility(const Mesh& mesh,
-                                                               const Eigen::Matrix3Xd& normals,
-                                                               const std::vector<Camera>& cameras,
-                                                               const VisibilityOptions& options,
-                                                               const std::vector<cv::Mat>& masks) {
+std::vector<std::vector<unsigned char>> ComputeFrameVisibility(
+    const Mesh& mesh, const Eigen::Matrix3Xd& normals, const std::vector<Camera>& cameras,
+    const VisibilityOptions& options, int wanted_cameras, const std::vector<cv::Mat>& masks) {
   Require(masks.empty() || masks.size() == cameras.size(), "ComputeFrameVisibility",
           "one mask per camera, or none, expected");
+  VisibilityOptions widest = options;
+  if (wanted_cameras > 0) widest.max_view_angle_deg = options.fallback_view_angle_deg;
   std::vector<std::vector<unsigned char>> visible(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     const DepthMap depth = RenderDepth(cameras[c], mesh);
-    visible[c] = ComputeVisibility(cameras[c], depth.depth, mesh.vertices, normals, options);
+    visible[c] = ComputeVisibility(cameras[c], depth.depth, mesh.vertices, normals, widest);
     if (!masks.empty()) KeepForeground(cameras[c], masks[c], mesh.vertices, 0, &visible[c]);
   }
+  if (wanted_cameras > 0) {
+    KeepFrontalViews(cameras, mesh.vertices, normals, wanted_cameras, options, &visible);
+  }
   return visible;
+}
+
+int CamerasWanted(const RefineOptions& options) {
+  return options.energy.similarity == SimilarityType::kConsensus
+             ? options.energy.consensus.min_cameras
+             : 1;
+}
+
+int FallbackCamerasWanted(const RefineOptions& options) {
+  return options.energy.similarity == SimilarityType::kConsensus ? CamerasWanted(options) : 0;
 }
 
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
@@ -141,8 +154,8 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
                                      const RefineOptions& options) {
   options.Check();
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(fine);
-  const auto visible =
-      ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility, frame.masks);
+  const auto visible = ComputeFrameVisibility(fine, normals, frame.cameras, options.visibility,
+                                              FallbackCamerasWanted(options), frame.masks);
   if (options.reference_colors == ReferenceColorSource::kImageModel) {
     const std::vector<ImageGaussians> images = FrameImageModels(frame, options.image);
     return ComputeModelReferenceColors(fine.vertices, normals, frame.cameras, images, visible,
@@ -165,8 +178,9 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
   frame.normals = ComputeVertexNormals(frame.fine);
-  frame.visible = ComputeFrameVisibility(frame.fine, frame.normals, input.cameras,
-                                         options.visibility, input.masks);
+  frame.visible =
+      ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility,
+                             FallbackCamerasWanted(options), input.masks);
   const auto& visible = frame.visible;
   frame.images = std::move(images);
 
@@ -181,6 +195,10 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
           : colors;
   SurfaceGaussians surface = MakeSurfaceGaussians(frame.fine.vertices, frame.normals,
                                                   model.refined_vertices(), frame_colors);
+  const std::vector<float> view_confidence =
+      ViewConfidence(input.cameras, frame.fine.vertices, frame.normals, CamerasWanted(options),
+                     options.visibility, visible);
+  for (int v : surface.vertex_ids) surface.view_confidence.push_back(view_confidence[v]);
   std::vector<CameraInput> cameras(input.cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     cameras[c].camera = input.cameras[c];
@@ -382,8 +400,10 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   const double bias = BiasCompensation(options);
   result.refined = frame.fine;
   result.k = Eigen::VectorXd::Constant(frame.fine.num_vertices(), std::nan(""));
+  result.confidence = result.k;
   const std::vector<int>& ids = frame.energy->surface().vertex_ids;
   for (size_t s = 0; s < ids.size(); ++s) {
+    result.confidence[ids[s]] = frame.energy->confidence()[s];
     const double displacement = result.kept_input ? 0.0 : k[s] + bias;
     result.k[ids[s]] = displacement;
     result.refined.vertices.col(ids[s]) += displacement * frame.normals.col(ids[s]);
@@ -394,6 +414,16 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
 }
 
 }  // namespace
+
+double ConfidentShare(const FrameResult& result) {
+  int refined = 0, confident = 0;
+  for (double confidence : result.confidence) {
+    if (std::isnan(confidence)) continue;
+    ++refined;
+    confident += confidence >= 0.5;
+  }
+  return refined > 0 ? static_cast<double>(confident) / refined : std::nan("");
+}
 
 int PatchRingsAt(const RefineOptions& options) {
   const int doublings = std::max(options.subdivision_levels - 1, 0);

@@ -279,6 +279,8 @@ class SequenceRun {
     SaveColors();
     prepare_ahead_ = !FollowsColors(options_);
     RmsOverFrames errors, flicker;
+    double confident_share_sum = 0.0;
+    int confident_shares = 0;
     for (int frame = frames.begin; frame < frames.end; ++frame) {
       if (Done(frame)) {
         observer_->FrameAlreadyDone(capture_->frame_name(frame));
@@ -287,6 +289,10 @@ class SequenceRun {
       }
       const FrameStats stats = RefineOne(frame, frames);
       ++result->refined;
+      if (std::isfinite(stats.confident_share)) {
+        confident_share_sum += stats.confident_share;
+        ++confident_shares;
+      }
       if (std::isfinite(stats.rms_refined_mm)) {
         errors.Add(stats.rms_coarse_mm, stats.rms_subdivided_mm, stats.rms_refined_mm);
       }
@@ -296,6 +302,8 @@ class SequenceRun {
       observer_->FrameRefined(stats);
     }
     SetRunFigures(errors, flicker, result);
+    result->confident_share =
+        confident_shares > 0 ? confident_share_sum / confident_shares : std::nan("");
   }
 
  private:

@@ -101,16 +101,13 @@ struct EnergyOptions {
   // textureless cloth) it keeps the input; where they do, the data outweighs it. Not in the
   // paper. Default 0.
   double w_prior = 0.0;
-  // Strength mu of a pull towards the input surface on wide plain regions of the cloth, in units
-  // of the median data curvature (input_prior.h). Not in the paper. 0 turns it off, the default:
-  // the consensus similarity weights each patch by its contrast at the input, so plain cloth
-  // already carries no weight, and the pull only held detail back (synth_textureless frames 1-9:
-  // plain band 7.12 mm RMS with the pull at 300, 5.94 mm without, input 8.37 mm; synth_skirt
-  // frames 0-5: 60.8 % of the detail recovered with it, 62.6 % without; the Middlebury temple's
-  // held-out NCC 0.560 with it, 0.624 without). surface_color needs it (configs/surface_color.yaml
-  // sets 300): without it the band of synth_textureless ended worse than the input (7.70 ->
-  // 10.3 mm; 7.70 mm with it).
-  double confidence_prior = 0.0;
+  // Strength mu of a pull towards the input surface where the images cannot decide k, in units
+  // of the median data curvature (input_prior.h): where too few cameras see a Gaussian, or only
+  // at steep angles, or the cloth around it is plain. Not in the paper. 0 turns it off. Default
+  // 1: on a sparse rig it keeps the surface that the cameras cannot see well where it was
+  // (docs/measurements.md, 2026-12-05); where they see it well it holds nothing. surface_color
+  // needs 300 (configs/surface_color.yaml): its single colours carry nothing on plain cloth.
+  double confidence_prior = 1.0;
   // The consensus similarity's options.
   ConsensusOptions consensus;
   // Colour variation, as a fraction of its median, below which the cloth counts as plain (the

@@ -76,6 +76,9 @@ class FrameEnergy {
   const Regularizer& regularizer() const { return regularizer_; }
   // p_s of E_prior = 1/2 sum_s p_s k_s^2 (input_prior.h), one entry per surface Gaussian.
   const Eigen::VectorXd& prior_curvature() const { return prior_curvature_; }
+  // c_s, how sure the images are of each k_s (Confidence, input_prior.h); the confidence pull
+  // (energy.confidence_prior) holds k_s at the input where it is low.
+  const Eigen::VectorXd& confidence() const { return confidence_; }
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 
@@ -93,6 +96,7 @@ class FrameEnergy {
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;
   Eigen::VectorXd prior_curvature_;
+  Eigen::VectorXd confidence_;
   long num_pairs_ = 0;
 };
 

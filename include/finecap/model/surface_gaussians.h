@@ -26,6 +26,9 @@ struct SurfaceGaussians {
   std::vector<Eigen::Vector3f> colors;  // eta_s, embedded in `color_space` (see color.h).
   ColorSpace color_space = ColorSpace::kHsv;
   double sigma_hat = 0.007;  // Standard deviation, metres (paper: 7 mm).
+  // How well this frame's cameras see each Gaussian, in [0, 1] (ViewConfidence, visibility.h);
+  // empty: fully, everywhere.
+  std::vector<float> view_confidence;
 
   int size() const { return static_cast<int>(vertex_ids.size()); }
 };

@@ -26,6 +26,14 @@ struct VisibilityOptions {
   // Gaussians with fewer than two. surface_color, which needs one, peaks closer to the truth with
   // 35 (skirt: 0.77 at 75, 0.95 at 35; configs/surface_color.yaml).
   double max_view_angle_deg = 60.0;
+  // Largest angle at which a camera still counts for a point that too few cameras see within
+  // max_view_angle_deg, degrees (ComputeFrameVisibility's `wanted`): such a point takes the most
+  // frontal of those that see it within this angle until it has enough. On a sparse rig most of
+  // the surface faces one camera and lies between two others (four cameras 90 degrees apart:
+  // 79 % of synth_skirt's vertices have one camera within 60 degrees). Evidence from steep views
+  // is weaker, and the view confidence (ViewConfidence) says how much weaker. Equal to
+  // max_view_angle_deg: no point takes a camera beyond that. Default 85.
+  double fallback_view_angle_deg = 85.0;
   // Points projecting closer than this to the image border are not used, pixels. Default 2.
   double border_margin = 2.0;
 
@@ -39,6 +47,23 @@ std::vector<unsigned char> ComputeVisibility(const Camera& camera, const cv::Mat
                                              const Eigen::Matrix3Xd& points,
                                              const Eigen::Matrix3Xd& normals,
                                              const VisibilityOptions& options);
+
+// Narrows `visible` (per camera, which points it sees within options.fallback_view_angle_deg,
+// as ComputeVisibility with max_view_angle_deg set to it gives) to the cameras within
+// options.max_view_angle_deg, except that a point that fewer than `wanted` of those see keeps the
+// most frontal others until it has `wanted` (or all it has).
+void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
+                      const Eigen::Matrix3Xd& normals, int wanted, const VisibilityOptions& options,
+                      std::vector<std::vector<unsigned char>>* visible);
+
+// How well `wanted` cameras see each point, in [0, 1], from the cameras `visible` says see it: 1
+// when the wanted-th most frontal of them is within options.max_view_angle_deg, falling linearly
+// in the cosine of its angle to 0 at options.fallback_view_angle_deg; 0 when fewer than `wanted`
+// see it. `wanted` >= 1.
+std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
+                                  const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
+                                  int wanted, const VisibilityOptions& options,
+                                  const std::vector<std::vector<unsigned char>>& visible);
 
 // The camera that sees `point` most frontally: among the cameras c for which `sees(c)` holds,
 // the one whose direction from `point` aligns best with `normal` (largest dot product; `normal`

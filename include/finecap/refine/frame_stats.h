@@ -38,6 +38,9 @@ struct FrameStats {
   // whichever part of a frame's work it goes to.
   double cpu_seconds = 0.0;
   int surface_gaussians = 0;
+  // The share of the refined vertices refined with confidence (ConfidentShare, refine.h), in
+  // [0, 1]: where the rest lie, the confidence pull keeps the input. Low on a sparse rig.
+  double confident_share = std::numeric_limits<double>::quiet_NaN();
   long image_gaussians = 0;
   long pairs = 0;
   bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.

@@ -31,8 +31,8 @@ struct ProblemSize {
   // Refined vertices that get a surface Gaussian: some camera sees them (within the view-angle
   // cap and not occluded) and they have a reference colour.
   int num_surface_gaussians = 0;
-  // Refined vertices that no camera sees within visibility.max_view_angle_deg: they keep the
-  // input surface.
+  // Refined vertices that no camera sees (ComputeFrameVisibility, within the fallback view
+  // angle where the similarity takes one): they keep the input surface.
   int num_unseen_refined_vertices = 0;
   // Per camera, the fine vertices it sees (refined or not): 0 marks a camera that sees nothing.
   std::vector<int> visible_per_camera;

@@ -198,11 +198,25 @@ struct FineGroundTruth {
   bool empty() const { return k_true.size() == 0; }
 };
 
-// For each camera, which fine vertices of `mesh` (with `normals`) it sees. With `masks` (one per
-// camera, as FrameInput::masks) a vertex whose nearest pixel is background is not seen.
+// For each camera, which fine vertices of `mesh` (with `normals`) it sees: within
+// options.max_view_angle_deg, and for a vertex that fewer than `wanted_cameras` see there, the
+// most frontal others within options.fallback_view_angle_deg until it has that many
+// (KeepFrontalViews; 0: none). With `masks` (one per camera, as FrameInput::masks) a vertex whose
+// nearest pixel is background is not seen.
 std::vector<std::vector<unsigned char>> ComputeFrameVisibility(
     const Mesh& mesh, const Eigen::Matrix3Xd& normals, const std::vector<Camera>& cameras,
-    const VisibilityOptions& options, const std::vector<cv::Mat>& masks = {});
+    const VisibilityOptions& options, int wanted_cameras, const std::vector<cv::Mat>& masks = {});
+
+// The cameras a refined vertex needs under `options`: the consensus similarity compares the
+// cameras that see a patch with each other and needs energy.consensus.min_cameras of them; the
+// others compare each camera with reference colours and need one. The vertex's view confidence
+// (ViewConfidence) is that of the wanted-th most frontal camera.
+int CamerasWanted(const RefineOptions& options);
+// The cameras a vertex takes beyond visibility.max_view_angle_deg when it has fewer within it
+// (ComputeFrameVisibility): CamerasWanted for the consensus similarity, none for the others,
+// whose reference colours and comparisons are each camera's own and gain nothing from a steep
+// view.
+int FallbackCamerasWanted(const RefineOptions& options);
 
 // The colours of the fine vertices, from the reference frame's images at its coarse surface.
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
@@ -264,6 +278,10 @@ struct FrameResult {
   Eigen::Matrix3Xd normals;  // Unit normals of `refined`.
   Eigen::VectorXd k;         // Per fine vertex, metres (bias included); NaN where not refined.
   Eigen::VectorXd k_solved;  // Per surface Gaussian, as solved (for warm starts).
+  // Per fine vertex, in [0, 1]: how surely the training images decide its displacement
+  // (FrameEnergy::confidence: the views that see it, the texture around it); NaN where not
+  // refined. The confidence pull holds a vertex near its input where this is low.
+  Eigen::VectorXd confidence;
   SolverSummary summary;
   bool worse = false;       // The solve ended with a lower energy than it started from.
   bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
@@ -283,6 +301,10 @@ struct FrameResult {
 // of the pixels, and its comparison of the cameras grows noisier than the finer unknowns gain
 // (Sceaux at level 2: held-out NCC 0.833 with one ring, 0.839 with two, 0.836 at level 1).
 int PatchRingsAt(const RefineOptions& options);
+
+// The share of the refined vertices of `result` refined with confidence (FrameResult::confidence
+// at least 1/2), in [0, 1]; NaN when none was refined.
+double ConfidentShare(const FrameResult& result);
 
 // What bias compensation adds along the normal to every solved displacement of a frame that was
 // refined: sigma_hat with RefineOptions::bias_compensation, else 0. A kept input gets nothing.

@@ -193,6 +193,9 @@ struct SequenceResult {
   double flicker_coarse_mm = 0.0;
   double flicker_subdivided_mm = 0.0;
   double flicker_refined_mm = 0.0;
+  // The mean over the frames refined now of their share of vertices refined with confidence
+  // (FrameStats::confident_share); NaN when none was.
+  double confident_share = 0.0;
 };
 
 // Refines frames [frames.begin, frames.end) of `capture` into the run folder `out` (created with
