@@ -1,6 +1,7 @@
 // The report seen in a browser: finecap eval's report.html of a tiny refined run with ground truth
 // and a held-out camera, opened in headless Chromium by scripts/check-report.sh, must show a
-// shaded mesh in every panel of the 3D view (input, refined coloured by its error, truth) and the
+// shaded mesh in every panel of the 3D view (input, refined coloured by its error, truth, refined
+// coloured by its confidence) and the
 // held-out comparison panels (the photo, what each mesh predicts there, their NCC maps), none
 // blank. Skipped with a message where three.js is not installed or Chromium cannot be installed
 // or started.
@@ -51,6 +52,7 @@ TEST(ReportViewerTest, ChromiumShowsTruthAndHeldOutComparisons) {
   EXPECT_NE(log.find("check-report: 3D view: input "), std::string::npos) << log;
   EXPECT_NE(log.find("; refined,_coloured_by_its_error "), std::string::npos) << log;
   EXPECT_NE(log.find("; truth "), std::string::npos) << log;
+  EXPECT_NE(log.find("; refined,_coloured_by_confidence "), std::string::npos) << log;
   // Both frames' comparison rows, each with its five pictures.
   for (const std::string frame : {"000000", "000001"}) {
     SCOPED_TRACE(frame);

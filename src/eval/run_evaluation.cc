@@ -488,7 +488,9 @@ constexpr int kViewerFrames = 5;
 // first from the eval camera: the subdivided input mesh, the refined mesh and, where the capture
 // has ground truth, the refined mesh coloured by |k - k_true| (the scale's top `error_scale`, the
 // sequence's 95th percentile of the input's error) and the true surface (the subdivided input
-// displaced by the true k along its normals, where the truth is known; the input elsewhere). Where
+// displaced by the true k along its normals, where the truth is known; the input elsewhere); and,
+// from runs that wrote it, the refined mesh coloured by its confidence (confidence/<frame>.txt:
+// where it is low, too few cameras saw the surface well and refine held it near the input). Where
 // three.js is absent a note takes its place and a warning goes to stderr: the report is still
 // written.
 std::string ViewerHtml(const std::vector<RefinedFrame>& frames, const SequenceModel& model,
@@ -512,6 +514,14 @@ std::string ViewerHtml(const std::vector<RefinedFrame>& frames, const SequenceMo
   } else {
     panels.push_back({"refined", 0xd9bc96, std::nullopt});
   }
+  bool with_confidence = true;
+  for (int i : shown_indices) {
+    with_confidence = with_confidence && fs::is_regular_file(frames[i].files.confidence);
+  }
+  if (with_confidence) {
+    panels.push_back({"refined, coloured by confidence", 0xd9bc96,
+                      ViewerColorScale{"confidence (0: held near the input)", 1.0, ""}});
+  }
   std::vector<ViewerFrame> shown;
   for (int i : shown_indices) {
     const RefinedFrame& frame = frames[i];
@@ -532,6 +542,12 @@ std::string ViewerHtml(const std::vector<RefinedFrame>& frames, const SequenceMo
         }
       }
       viewed.surfaces.push_back({std::move(truth), {}});
+    }
+    if (with_confidence) {
+      const Mesh& refined = viewed.surfaces[1].mesh;
+      const Eigen::VectorXd confidence =
+          ReadConfidence(frame.files.confidence, refined.num_vertices());
+      viewed.surfaces.push_back({refined, HeatMapColors(confidence, 1.0)});
     }
     shown.push_back(std::move(viewed));
   }

@@ -21,7 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const char* const kSubfolders[] = {"meshes", "k", "traces", "frames"};
+const char* const kSubfolders[] = {"meshes", "k", "traces", "frames", "confidence"};
 
 // Holds an exclusive flock on `path` (created if missing) while it lives.
 class FileLock {
@@ -50,7 +50,7 @@ std::string MeshFormatExtension(MeshFormat format) {
 FrameFiles FrameFilesIn(const std::string& out, const std::string& frame, MeshFormat mesh_format) {
   return {out + "/meshes/" + frame + "." + MeshFormatExtension(mesh_format),
           out + "/k/" + frame + ".txt", out + "/traces/" + frame + ".csv",
-          out + "/frames/" + frame + ".json"};
+          out + "/confidence/" + frame + ".txt", out + "/frames/" + frame + ".json"};
 }
 
 bool FrameDone(const FrameFiles& files) {
@@ -66,19 +66,24 @@ std::string FollowedColorsPath(const std::string& out, const std::string& frame)
 std::string EvalFolder(const std::string& out) { return out + "/eval"; }
 std::string ExportFolder(const std::string& out) { return out + "/export"; }
 
-void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k) {
-  std::string text =
-      "# displacement along the normal of each vertex of the refined mesh, metres; nan where "
-      "not refined\n";
+namespace {
+
+// One number per vertex after a '#' header line, each in the shortest form that reads back to the
+// same double.
+void WriteVertexValues(const std::string& path, const std::string& header,
+                       const Eigen::VectorXd& values) {
+  std::string text = "# " + header + "\n";
   char number[64];
-  for (int v = 0; v < k.size(); ++v) {
-    const auto written = std::to_chars(number, number + sizeof(number), k[v]);
+  for (int v = 0; v < values.size(); ++v) {
+    const auto written = std::to_chars(number, number + sizeof(number), values[v]);
     text.append(number, written.ptr).push_back('\n');
   }
   WriteTextFileAtomically(path, text);
 }
 
-Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
+// WriteVertexValues' numbers, `what` naming them in an Error.
+Eigen::VectorXd ReadVertexValues(const std::string& path, int num_vertices,
+                                 const std::string& what) {
   std::istringstream text(internal::ReadWholeFile(path));
   std::vector<double> values;
   std::string line;
@@ -91,9 +96,33 @@ Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
     values.push_back(value);
   }
   Require(static_cast<int>(values.size()) == num_vertices, path,
-          "holds " + std::to_string(values.size()) + " displacements, the refined mesh has " +
+          "holds " + std::to_string(values.size()) + " " + what + ", the refined mesh has " +
               std::to_string(num_vertices) + " vertices");
   return Eigen::Map<const Eigen::VectorXd>(values.data(), values.size());
+}
+
+}  // namespace
+
+void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k) {
+  WriteVertexValues(path,
+                    "displacement along the normal of each vertex of the refined mesh, metres; "
+                    "nan where not refined",
+                    k);
+}
+
+Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices) {
+  return ReadVertexValues(path, num_vertices, "displacements");
+}
+
+void WriteConfidence(const std::string& path, const Eigen::VectorXd& confidence) {
+  WriteVertexValues(path,
+                    "confidence of each vertex of the refined mesh, 0 (held near the input) to 1 "
+                    "(the images decide it); nan where not refined",
+                    confidence);
+}
+
+Eigen::VectorXd ReadConfidence(const std::string& path, int num_vertices) {
+  return ReadVertexValues(path, num_vertices, "confidences");
 }
 
 std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,

@@ -197,6 +197,7 @@ void WriteFrame(const FrameFiles& files, const FrameResult& result, MeshFormat f
   const Eigen::VectorXd quality = result.k.array().isFinite().select(result.k, 0.0);
   WriteMesh(files.mesh, result.refined, {result.normals, {}, quality}, format);
   WriteDisplacement(files.displacement, result.k);
+  WriteConfidence(files.confidence, result.confidence);
   WriteTextFileAtomically(files.trace, SolverTraceCsv(result.summary.trace));
   // Inside the frame's time, so that the CPU is never more than that time on every core.
   stats->cpu_seconds = ProcessCpuSeconds() - cpu_seconds_at_start;

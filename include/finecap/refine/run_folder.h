@@ -34,7 +34,10 @@ struct FrameFiles {
   std::string mesh;          // meshes/<frame>.<mesh_format>
   std::string displacement;  // k/<frame>.txt
   std::string trace;         // traces/<frame>.csv, the solver's convergence (not needed to resume)
-  std::string stats;         // frames/<frame>.json, written last: it marks the frame done.
+  // confidence/<frame>.txt, per fine vertex how surely the images decide it (FrameResult::
+  // confidence; not needed to resume, and absent from runs of versions before it).
+  std::string confidence;
+  std::string stats;  // frames/<frame>.json, written last: it marks the frame done.
 };
 
 // "ply" or "obj": the extension of a mesh written in `format`.
@@ -61,6 +64,10 @@ void WriteDisplacement(const std::string& path, const Eigen::VectorXd& k);
 // Reads k/<frame>.txt; an Error names the file when a line is not a number or nan ('#' lines are
 // comments) or when it does not hold `num_vertices` of them.
 Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices);
+
+// confidence/<frame>.txt, as k/<frame>.txt: one number in [0, 1] (or nan) per fine vertex.
+void WriteConfidence(const std::string& path, const Eigen::VectorXd& confidence);
+Eigen::VectorXd ReadConfidence(const std::string& path, int num_vertices);
 
 // A done frame of a run folder.
 struct RefinedFrame {
