@@ -43,8 +43,12 @@ echo "demo:   with configs/demo.yaml: similarity $(json_value similarity "$stats
 printf 'demo: RMS error against the truth %.3f mm as given -> %.3f mm refined:' \
   "$(json_value rms_coarse_mm "$metrics")" "$(json_value rms_refined_mm "$metrics")"
 awk -v r="$recovered" 'BEGIN { printf " %.1f %% of the detail recovered\n", 100 * r }'
-echo "demo: open the report (figures; 3D view of the input, the refined mesh coloured by its error and"
-echo "demo:   the truth; plots; pictures):"
+# Refine's own measure, from the training images alone: how much of the surface enough cameras see
+# well enough for the images to decide it (the rest is held near the input).
+grep -o '"confident_share": *[0-9.]*' "$stats" | sed 's/.*: *//' |
+  awk '{ sum += $1; n += 1 } END { printf "demo: %.0f %% of the vertices refined with confidence (mean over the frames)\n", 100 * sum / n }'
+echo "demo: open the report (figures; 3D view of the input, the refined mesh coloured by its error,"
+echo "demo:   the truth and the refined mesh coloured by its confidence; plots; pictures):"
 echo "  $PWD/out/demo/eval/report.html"
 echo "demo: the image | normals of the input | normals refined, the detail added:"
 echo "  $PWD/$normals"
