@@ -135,24 +135,34 @@ TEST(PriorCurvatureTest, AddsTheUniformPullAndTheScaledConfidencePull) {
 }
 
 // On plain cloth the pull is on everywhere: the scalar energy, its gradient and the
-// least-squares cost the Ceres solver minimises must all include it, and agree.
+// least-squares cost the Ceres solver minimises must all include it, and agree; with the input as
+// given off the subdivided surface (an approximating subdivision) the pull is towards it.
 TEST(InputPriorEnergyTest, ScalarGradientAndLeastSquaresFormAgree) {
-  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 9);
-  for (Eigen::Vector3f& color : scene.surface.colors) color = Eigen::Vector3f(0.4f, 0.3f, 0.3f);
-  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(50));
-  EXPECT_GT(energy.prior_curvature().minCoeff(), 0.0);
+  for (const bool off_the_input : {false, true}) {
+    SCOPED_TRACE(off_the_input ? "input as given off k = 0" : "input as given at k = 0");
+    EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 9);
+    for (Eigen::Vector3f& color : scene.surface.colors) color = Eigen::Vector3f(0.4f, 0.3f, 0.3f);
+    if (off_the_input) {
+      const Eigen::VectorXd offsets = RandomK(scene.surface.size(), 0.002, 11);
+      scene.surface.input_offset.assign(offsets.data(), offsets.data() + offsets.size());
+    }
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(50));
+    EXPECT_GT(energy.prior_curvature().minCoeff(), 0.0);
+    EXPECT_EQ(energy.prior_target().norm() > 0.0, off_the_input);
 
-  const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.004, 10);
-  Eigen::VectorXd gradient;
-  double similarity = 0.0, regularization = 0.0;
-  const double e = energy.Evaluate(k, &gradient, &similarity, &regularization);
-  const double prior = 0.5 * k.dot(energy.prior_curvature().cwiseProduct(k));
-  EXPECT_NEAR(e, similarity - energy.options().w_reg * regularization - prior, 1e-12 * prior);
-  EXPECT_NEAR(LeastSquaresCost(&energy, k), -e, 1e-9 * std::abs(e));
+    const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.004, 10);
+    Eigen::VectorXd gradient;
+    double similarity = 0.0, regularization = 0.0;
+    const double e = energy.Evaluate(k, &gradient, &similarity, &regularization);
+    const Eigen::VectorXd from_target = k - energy.prior_target();
+    const double prior = 0.5 * from_target.dot(energy.prior_curvature().cwiseProduct(from_target));
+    EXPECT_NEAR(e, similarity - energy.options().w_reg * regularization - prior, 1e-12 * prior);
+    EXPECT_NEAR(LeastSquaresCost(&energy, k), -e, 1e-9 * std::abs(e));
 
-  const Eigen::VectorXd numeric = NumericGradient(
-      [&](const Eigen::VectorXd& x) { return energy.Evaluate(x, nullptr); }, k, 1e-7);
-  EXPECT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm());
+    const Eigen::VectorXd numeric = NumericGradient(
+        [&](const Eigen::VectorXd& x) { return energy.Evaluate(x, nullptr); }, k, 1e-7);
+    EXPECT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm());
+  }
 }
 
 }  // namespace

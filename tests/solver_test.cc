@@ -100,6 +100,15 @@ TEST(CeresCostTest, SmoothnessBlocksPassTheGradientChecker) {
   const SmoothnessBlockCost prior_only(0.7, {}, 0);
   EXPECT_EQ(prior_only.num_residuals(), 1);
   EXPECT_TRUE(CheckGradient(prior_only, {0.004}, &error)) << error;
+  // A prior towards the input as given, 3 mm off k = 0: its residual vanishes there.
+  const SmoothnessBlockCost prior_off(0.7, {{1, 3.5}}, 1, 0.003);
+  EXPECT_TRUE(CheckGradient(prior_off, {0.004, -0.002}, &error)) << error;
+  const double at_target[] = {0.003, 0.003};
+  const double* parameters[] = {&at_target[0], &at_target[1]};
+  double residuals[2] = {1.0, 1.0};
+  ASSERT_TRUE(prior_off.Evaluate(parameters, residuals, nullptr));
+  EXPECT_EQ(residuals[0], 0.0);
+  EXPECT_EQ(residuals[1], 0.0);
 }
 
 // A surface Gaussian's merged block (its row of GaussianModelRows, with a prior, and three
@@ -431,12 +440,17 @@ TEST(SolverSummaryTest, AddWorkSumsCountsAndTimes) {
 }
 
 // The problem Ceres is given (similarity blocks, one smoothness block per Gaussian) has the cost
-// LeastSquaresCost computes term by term, with the regulariser and a prior both present: every
+// LeastSquaresCost computes term by term, with the regulariser and a prior (towards an input off
+// k = 0) both present: every
 // pair and every prior is in exactly one block.
 TEST(SolverTest, CeresProblemHasTheLeastSquaresCost) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.6}, 3, 23);
   EnergyOptions energy_options = Options("surface_color", "printed");
   energy_options.w_prior = 1e-4;
+  // The input as given off the subdivided surface, so that the prior's rows hold their targets.
+  for (int s = 0; s < scene.surface.size(); ++s) {
+    scene.surface.input_offset.push_back(0.001 * std::cos(0.7 * s));
+  }
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, energy_options);
   ASSERT_GT(energy.prior_curvature().maxCoeff(), 0.0);
   ASSERT_FALSE(energy.regularizer().pairs().empty());

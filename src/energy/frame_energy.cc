@@ -106,6 +106,10 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
     data_curvature = DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size()));
   }
   prior_curvature_ = PriorCurvature(data_curvature, confidence_, surface_.size(), options_);
+  prior_target_ =
+      surface_.input_offset.empty()
+          ? Eigen::VectorXd::Zero(surface_.size())
+          : Eigen::Map<const Eigen::VectorXd>(surface_.input_offset.data(), surface_.size()).eval();
   for (EnergyView& view : views_) {
     num_pairs_ += view.pairs.num_pairs();
     if (similarity_->ReadsPairLists()) continue;
@@ -124,11 +128,13 @@ double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient
   const double e_reg = regularizer_.Evaluate(k, gradient ? &regularization_gradient : nullptr);
   if (gradient != nullptr) {
     *gradient = similarity_gradient - options_.w_reg * regularization_gradient -
-                prior_curvature_.cwiseProduct(k);
+                prior_curvature_.cwiseProduct(k - prior_target_);
   }
   if (similarity != nullptr) *similarity = e_sim;
   if (regularization != nullptr) *regularization = e_reg;
-  return e_sim - options_.w_reg * e_reg - 0.5 * k.dot(prior_curvature_.cwiseProduct(k));
+  const Eigen::VectorXd from_target = k - prior_target_;
+  return e_sim - options_.w_reg * e_reg -
+         0.5 * from_target.dot(prior_curvature_.cwiseProduct(from_target));
 }
 
 }  // namespace finecap

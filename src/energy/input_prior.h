@@ -1,15 +1,17 @@
-// The pull of the displacements towards the input surface (k = 0), not in the paper:
+// The pull of the displacements towards the input surface as given (k_s = t_s), not in the paper:
 //
-//   E_prior(k) = 1/2 sum_s p_s k_s^2,   E = E_sim - w_reg E_reg - E_prior,
+//   E_prior(k) = 1/2 sum_s p_s (k_s - t_s)^2,   E = E_sim - w_reg E_reg - E_prior,
 //
-// with a curvature p_s per surface Gaussian. Where a plain cloth shows no texture, the colour
-// residuals do not change with k_s and only the regulariser decides it: it carries the
-// displacement of the textured surroundings into the plain region, which can be worse than the
-// input. So can steep views, and too few cameras: on a sparse rig much of the surface is seen
-// well by one camera only. A uniform pull (energy.w_prior) prevents that but costs detail
-// wherever the images do constrain k. The confidence pull (energy.confidence_prior) holds each
-// Gaussian by how little the images decide it (Confidence: the views that see it, the texture
-// around it), with a strength in the units of the data's own curvature.
+// with a curvature p_s per surface Gaussian and its target t_s, where the input as given lies along
+// its normal (0 unless the subdivision approximates: Loop moves the input's vertices). Where a
+// plain cloth shows no texture, the colour residuals do not change with k_s and only the
+// regulariser decides it: it carries the displacement of the textured surroundings into the plain
+// region, which can be worse than the input. So can steep views, and too few cameras: on a sparse
+// rig much of the surface is seen well by one camera only. A uniform pull (energy.w_prior) prevents
+// that but costs detail wherever the images do constrain k. The confidence pull
+// (energy.confidence_prior) holds each Gaussian by how little the images decide it (Confidence: the
+// views that see it, the texture around it), with a strength in the units of the data's own
+// curvature.
 #ifndef FINECAP_INPUT_PRIOR_H_
 #define FINECAP_INPUT_PRIOR_H_
 

@@ -168,6 +168,19 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 
 namespace {
 
+// Where the input as given (its faces, SequenceModel::Interpolate) lies from each of the fine
+// vertices `ids` of its subdivision `fine`, along their `normals`, metres.
+std::vector<double> InputOffsets(const SequenceModel& model, const Mesh& coarse, const Mesh& fine,
+                                 const Eigen::Matrix3Xd& normals, const std::vector<int>& ids) {
+  const Mesh as_given = model.Interpolate(coarse);
+  std::vector<double> offsets;
+  offsets.reserve(ids.size());
+  for (int v : ids) {
+    offsets.push_back((as_given.vertices.col(v) - fine.vertices.col(v)).dot(normals.col(v)));
+  }
+  return offsets;
+}
+
 // PrepareFrame without checking `options`, over the image models `images` of the input's images
 // under options.image: the coarse levels of a schedule widen sigma_hat and the leaves past the
 // ranges that a configured value must lie in.
@@ -199,6 +212,8 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
       ViewConfidence(input.cameras, frame.fine.vertices, frame.normals, CamerasWanted(options),
                      options.visibility, visible);
   for (int v : surface.vertex_ids) surface.view_confidence.push_back(view_confidence[v]);
+  surface.input_offset =
+      InputOffsets(model, input.coarse, frame.fine, frame.normals, surface.vertex_ids);
   std::vector<CameraInput> cameras(input.cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     cameras[c].camera = input.cameras[c];

@@ -181,22 +181,23 @@ bool IsolatedSimilarityBlockCost::Evaluate(double const* const* parameters, doub
 }
 
 SmoothnessBlockCost::SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours,
-                                         int num_free)
-    : prior_root_(prior_root), neighbours_(std::move(neighbours)) {
+                                         int num_free, double prior_target)
+    : prior_root_(prior_root), prior_target_(prior_target), neighbours_(std::move(neighbours)) {
   set_num_residuals(NumRows(prior_root_, static_cast<int>(neighbours_.size())));
   mutable_parameter_block_sizes()->assign(1 + num_free, 1);
 }
 
 bool SmoothnessBlockCost::Evaluate(double const* const* parameters, double* residuals,
                                    double** jacobians) const {
-  Rows(prior_root_, neighbours_.data(), static_cast<int>(neighbours_.size()),
+  Rows(prior_root_, prior_target_, neighbours_.data(), static_cast<int>(neighbours_.size()),
        static_cast<int>(parameter_block_sizes().size()), parameters, residuals, jacobians, 0);
   return true;
 }
 
-void SmoothnessBlockCost::Rows(double prior_root, const Neighbour* neighbours, int num_neighbours,
-                               int num_parameters, double const* const* parameters,
-                               double* residuals, double** jacobians, int first_row) {
+void SmoothnessBlockCost::Rows(double prior_root, double prior_target, const Neighbour* neighbours,
+                               int num_neighbours, int num_parameters,
+                               double const* const* parameters, double* residuals,
+                               double** jacobians, int first_row) {
   const int num_rows = NumRows(prior_root, num_neighbours);
   const auto jacobian = [&](int p) {
     return jacobians != nullptr && jacobians[p] != nullptr ? jacobians[p] + first_row : nullptr;
@@ -208,7 +209,7 @@ void SmoothnessBlockCost::Rows(double prior_root, const Neighbour* neighbours, i
   double* own = jacobian(0);
   int r = 0;
   if (prior_root > 0.0) {
-    residuals[r] = prior_root * k;
+    residuals[r] = prior_root * (k - prior_target);
     if (own != nullptr) own[r] = prior_root;
     ++r;
   }
@@ -224,11 +225,12 @@ void SmoothnessBlockCost::Rows(double prior_root, const Neighbour* neighbours, i
   }
 }
 
-int GaussianModelRows::Add(int parameter, int block, double prior) {
+int GaussianModelRows::Add(int parameter, int block, double prior, double target) {
   Gaussian gaussian;
   gaussian.parameter = parameter;
   gaussian.block = block;
   gaussian.prior = prior;
+  gaussian.target = target;
   gaussians_.push_back(gaussian);
   return size() - 1;
 }
@@ -238,14 +240,16 @@ void GaussianModelRows::Prepare(const Eigen::VectorXd& k) {
   for (Gaussian& gaussian : gaussians_) {
     const SimilarityTerm::BlockSummary& summary = SummaryOf(gaussian);
     const double k_s = k[gaussian.parameter];
+    const double from_target = k_s - gaussian.target;
     const double curvature = gaussian.curvature.At(k_s, summary, secant_) + gaussian.prior;
     gaussian.length = std::sqrt(curvature);
-    gaussian.row =
-        gaussian.length > 0.0 ? (summary.gradient + gaussian.prior * k_s) / gaussian.length : 0.0;
-    // (g + p k)^2 / (h + p) <= |r|^2 + p k^2 (Cauchy-Schwarz, h >= g^2 / |r|^2): rounding may
-    // make the difference a hair negative.
-    remainder += std::max(
-        0.0, summary.squared_norm + gaussian.prior * k_s * k_s - gaussian.row * gaussian.row);
+    gaussian.row = gaussian.length > 0.0
+                       ? (summary.gradient + gaussian.prior * from_target) / gaussian.length
+                       : 0.0;
+    // (g + p d)^2 / (h + p) <= |r|^2 + p d^2, d = k - t (Cauchy-Schwarz, h >= g^2 / |r|^2):
+    // rounding may make the difference a hair negative.
+    remainder += std::max(0.0, summary.squared_norm + gaussian.prior * from_target * from_target -
+                                   gaussian.row * gaussian.row);
   }
   remainder_norm_ = std::sqrt(remainder);
 }
@@ -256,7 +260,8 @@ void GaussianModelRows::ForgetHistories() {
 
 double GaussianModelRows::Norm(int i, double k) const {
   const Gaussian& gaussian = gaussians_[i];
-  return std::sqrt(SummaryOf(gaussian).squared_norm + gaussian.prior * k * k);
+  const double from_target = k - gaussian.target;
+  return std::sqrt(SummaryOf(gaussian).squared_norm + gaussian.prior * from_target * from_target);
 }
 
 SurfaceGaussianCost::SurfaceGaussianCost(const GaussianModelRows& rows, int i,
@@ -281,7 +286,7 @@ bool SurfaceGaussianCost::Evaluate(double const* const* parameters, double* resi
       if (jacobians[p] != nullptr) jacobians[p][0] = 0.0;
     }
   }
-  SmoothnessBlockCost::Rows(0.0, neighbours_, num_neighbours_, num_parameters, parameters,
+  SmoothnessBlockCost::Rows(0.0, 0.0, neighbours_, num_neighbours_, num_parameters, parameters,
                             residuals + 1, jacobians, 1);
   return true;
 }
@@ -373,6 +378,7 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
   neighbour_other_ = rows.other;
   model_rows_ = std::make_unique<GaussianModelRows>(energy.similarity(), secant);
   const Eigen::VectorXd& prior = energy.prior_curvature();
+  const Eigen::VectorXd& target = energy.prior_target();
   std::vector<double*> parameter_blocks;
   for (int s = 0; s < num_gaussians; ++s) {
     if (!per_gaussian && rows.empty(s)) continue;
@@ -380,7 +386,7 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
     const int num_free = static_cast<int>(parameter_blocks.size()) - 1;
     const SmoothnessBlockCost::Neighbour* neighbours = neighbours_.data() + rows.begin[s];
     if (per_gaussian) {
-      const int row = model_rows_->Add(s, merged[s], std::max(0.0, prior[s]));
+      const int row = model_rows_->Add(s, merged[s], std::max(0.0, prior[s]), target[s]);
       surface_gaussians_.emplace_back(*model_rows_, row, neighbours, rows.num_neighbours(s),
                                       num_free);
       problem->AddResidualBlock(&surface_gaussians_.back(), nullptr, parameter_blocks);
@@ -388,7 +394,7 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
       smoothness_.emplace_back(rows.prior_root[s],
                                std::vector<SmoothnessBlockCost::Neighbour>(
                                    neighbours, neighbours + rows.num_neighbours(s)),
-                               num_free);
+                               num_free, target[s]);
       problem->AddResidualBlock(&smoothness_.back(), nullptr, parameter_blocks);
     }
   }
@@ -419,7 +425,10 @@ bool FrameCostFunctions::Rebind(const FrameEnergy& energy) {
   std::copy(rows.neighbours.begin(), rows.neighbours.end(), neighbours_.begin());
   model_rows_->Rebind(term);
   const Eigen::VectorXd& prior = energy.prior_curvature();
-  for (int s = 0; s < num_gaussians; ++s) model_rows_->Set(s, block_of[s], std::max(0.0, prior[s]));
+  const Eigen::VectorXd& target = energy.prior_target();
+  for (int s = 0; s < num_gaussians; ++s) {
+    model_rows_->Set(s, block_of[s], std::max(0.0, prior[s]), target[s]);
+  }
   return true;
 }
 

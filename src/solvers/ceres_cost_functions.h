@@ -156,7 +156,7 @@ class IsolatedSimilarityBlockCost : public SimilarityBlockCost {
 };
 
 // The quadratic terms that touch one surface Gaussian s, as one residual block: its pull towards
-// the input (r = sqrt(h_s) k_s, when h_s > 0) and the regulariser's pairs assigned to it
+// the input (r = sqrt(p_s) (k_s - t_s), when p_s > 0) and the regulariser's pairs assigned to it
 // (r = c_j (k_s - k_j), or r = c_j k_s when the neighbour is fixed at 0, with
 // c_j = 2 sqrt(w_reg T(delta_sj)) u, so that 1/2 sum r^2 = w_reg E_reg, regularizer.h). Every
 // pair belongs to exactly one of its two Gaussians. One block per Gaussian instead of one per
@@ -170,16 +170,18 @@ class SmoothnessBlockCost : public ceres::CostFunction {
     int parameter = -1;  // Index of k_j among the parameter blocks (>= 1), or -1 when fixed at 0.
     double coefficient = 0.0;  // c_j.
   };
-  // `prior_root` is sqrt(h_s), or 0 for no prior residual.
-  SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours, int num_free);
+  // `prior_root` is sqrt(p_s), or 0 for no prior residual sqrt(p_s) (k_s - t_s), whose target t_s
+  // is `prior_target` (FrameEnergy::prior_target).
+  SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours, int num_free,
+                      double prior_target = 0.0);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
   // The residuals (and, unless `jacobians` is null, their rows of each parameter block's Jacobian
   // column, from row `first_row` on) of the smoothness terms with `num_neighbours` neighbours
   // from `neighbours` on.
-  static void Rows(double prior_root, const Neighbour* neighbours, int num_neighbours,
-                   int num_parameters, double const* const* parameters, double* residuals,
-                   double** jacobians, int first_row);
+  static void Rows(double prior_root, double prior_target, const Neighbour* neighbours,
+                   int num_neighbours, int num_parameters, double const* const* parameters,
+                   double* residuals, double** jacobians, int first_row);
   // How many residuals Rows writes.
   static int NumRows(double prior_root, int num_neighbours) {
     return num_neighbours + (prior_root > 0.0 ? 1 : 0);
@@ -187,6 +189,7 @@ class SmoothnessBlockCost : public ceres::CostFunction {
 
  private:
   double prior_root_;
+  double prior_target_;
   std::vector<Neighbour> neighbours_;
 };
 
@@ -208,14 +211,15 @@ class GaussianModelRows {
  public:
   GaussianModelRows(const SimilarityTerm& term, bool secant) : term_(&term), secant_(secant) {}
   // Adds surface Gaussian `parameter` (its index in k), its similarity block `block` of one
-  // parameter (-1 for none: its row is then its prior's alone) and its prior's curvature p_s (0
-  // for none); returns its index among the rows.
-  int Add(int parameter, int block, double prior);
+  // parameter (-1 for none: its row is then its prior's alone), its prior's curvature p_s (0 for
+  // none) and target t_s (the prior is 1/2 p_s (k_s - t_s)^2); returns its index among the rows.
+  int Add(int parameter, int block, double prior, double target = 0.0);
   // Reads `term` from now on; Gaussian i's block and prior are then Set anew.
   void Rebind(const SimilarityTerm& term) { term_ = &term; }
-  void Set(int i, int block, double prior) {
+  void Set(int i, int block, double prior, double target = 0.0) {
     gaussians_[i].block = block;
     gaussians_[i].prior = prior;
+    gaussians_[i].target = target;
   }
   // Every row, its Jacobian and the remainder at k, the term's block summaries prepared there;
   // with the secant, records each Gaussian's gradient for the next point's curvature.
@@ -237,6 +241,7 @@ class GaussianModelRows {
     int parameter = -1;
     int block = -1;
     double prior = 0.0;
+    double target = 0.0;
     BlockCurvature curvature;
     double row = 0.0, length = 0.0;
   };

@@ -122,21 +122,32 @@ TEST(QualityTest, SkirtWithFoldsInFrameZeroRecoversTheDetail) {
 
 // The same skirt on sparse rigs (bench/camera_counts.sh): with 3 cameras 120 degrees apart no
 // point has two cameras within 60 degrees, and a refinement must leave what it cannot see well
-// as it was; with 4 it must find detail. Today (2026-12-05): 3 cameras +0.9 % pooled, the worst
-// frame +0.6 %, 15 % of the vertices refined with confidence; 4 cameras 14.9 % pooled, the worst
-// frame 14.6 %, 52 % with confidence. Before the fallback views and the confidence pull both
-// ended worse than their input (-0.0 % and -7.0 %).
+// as it was, also where its subdivision moved the input (the smoothed skirt: Loop's surface is
+// 5.02 mm from the truth, the input as given 4.93 mm); with 4 it must find detail. Today
+// (2026-12-05): skirt 3 cameras +1.0 % pooled, the worst frame +0.7 %, 15 % of the vertices
+// refined with confidence; 4 cameras 14.9 %, the worst frame 14.6 %, 52 % with confidence; the
+// smoothed skirt 3 cameras +1.0 %, the worst frame +0.3 %. Before the fallback views and the
+// confidence pull all three ended worse than their input (-0.0 %, -7.0 %, -1.9 %).
 TEST(QualityTest, SparseRigsEndNoWorseThanTheirInput) {
-  for (const int cameras : {3, 4}) {
-    SCOPED_TRACE(std::to_string(cameras) + " cameras");
-    const std::vector<YAML::Node> records =
-        SynthAndRefine("sparse_" + std::to_string(cameras), "synth_skirt.yaml",
-                       "synth.cameras.count=" + std::to_string(cameras));
+  struct Rig {
+    const char* config;
+    int cameras;
+    double min_gain;  // Per frame.
+    double max_confident_share;
+  };
+  for (const Rig& rig : {Rig{"synth_skirt.yaml", 3, 0.0, 0.3},
+                         Rig{"synth_skirt.yaml", 4, 0.096, 0.7},  // Margin 5 points.
+                         Rig{"synth_skirt_smoothed.yaml", 3, 0.0, 0.3}}) {
+    const std::string name = std::string(rig.config) + ", " + std::to_string(rig.cameras);
+    SCOPED_TRACE(name + " cameras");
+    const std::vector<YAML::Node> records = SynthAndRefine(
+        "sparse_" + std::string(rig.config).substr(0, 12) + "_" + std::to_string(rig.cameras),
+        rig.config, "synth.cameras.count=" + std::to_string(rig.cameras));
     ASSERT_EQ(records.size(), 3u);
     for (const YAML::Node& record : records) {
       SCOPED_TRACE(record["frame"].as<std::string>());
-      EXPECT_GT(Gain(record), cameras == 3 ? 0.0 : 0.096);  // Margin 5 points at 4 cameras.
-      EXPECT_LT(record["confident_share"].as<double>(), cameras == 3 ? 0.3 : 0.7);
+      EXPECT_GT(Gain(record), rig.min_gain);
+      EXPECT_LT(record["confident_share"].as<double>(), rig.max_confident_share);
     }
   }
 }

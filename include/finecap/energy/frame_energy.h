@@ -74,8 +74,10 @@ class FrameEnergy {
   SimilarityTerm& similarity() { return *similarity_; }
   const SimilarityTerm& similarity() const { return *similarity_; }
   const Regularizer& regularizer() const { return regularizer_; }
-  // p_s of E_prior = 1/2 sum_s p_s k_s^2 (input_prior.h), one entry per surface Gaussian.
+  // p_s and t_s of E_prior = 1/2 sum_s p_s (k_s - t_s)^2 (input_prior.h), one entry per surface
+  // Gaussian: t_s is where the input as given lies (SurfaceGaussians::input_offset; 0 without).
   const Eigen::VectorXd& prior_curvature() const { return prior_curvature_; }
+  const Eigen::VectorXd& prior_target() const { return prior_target_; }
   // c_s, how sure the images are of each k_s (Confidence, input_prior.h); the confidence pull
   // (energy.confidence_prior) holds k_s at the input where it is low.
   const Eigen::VectorXd& confidence() const { return confidence_; }
@@ -96,6 +98,7 @@ class FrameEnergy {
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;
   Eigen::VectorXd prior_curvature_;
+  Eigen::VectorXd prior_target_;
   Eigen::VectorXd confidence_;
   long num_pairs_ = 0;
 };

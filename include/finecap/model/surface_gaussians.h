@@ -29,6 +29,10 @@ struct SurfaceGaussians {
   // How well this frame's cameras see each Gaussian, in [0, 1] (ViewConfidence, visibility.h);
   // empty: fully, everywhere.
   std::vector<float> view_confidence;
+  // Where the input as given lies from each Gaussian along its normal, metres: an approximating
+  // subdivision (Loop) moves the input's surface, and a pull towards the input means towards
+  // this. Empty: at k = 0.
+  std::vector<double> input_offset;
 
   int size() const { return static_cast<int>(vertex_ids.size()); }
 };
