@@ -138,11 +138,10 @@ TEST(QualityTest, SparseRigsEndNoWorseThanTheirInput) {
   for (const Rig& rig : {Rig{"synth_skirt.yaml", 3, 0.0, 0.3},
                          Rig{"synth_skirt.yaml", 4, 0.096, 0.7},  // Margin 5 points.
                          Rig{"synth_skirt_smoothed.yaml", 3, 0.0, 0.3}}) {
-    const std::string name = std::string(rig.config) + ", " + std::to_string(rig.cameras);
+    const std::string name = std::string(rig.config) + "_" + std::to_string(rig.cameras);
     SCOPED_TRACE(name + " cameras");
-    const std::vector<YAML::Node> records = SynthAndRefine(
-        "sparse_" + std::string(rig.config).substr(0, 12) + "_" + std::to_string(rig.cameras),
-        rig.config, "synth.cameras.count=" + std::to_string(rig.cameras));
+    const std::vector<YAML::Node> records =
+        SynthAndRefine(name, rig.config, "synth.cameras.count=" + std::to_string(rig.cameras));
     ASSERT_EQ(records.size(), 3u);
     for (const YAML::Node& record : records) {
       SCOPED_TRACE(record["frame"].as<std::string>());
