@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "finecap/commands/commands.h"
 #include "finecap/io/camera_io.h"
@@ -299,6 +301,33 @@ TEST_F(ColmapWorkspaceTest, OpensEachLayoutAsOneFrame) {
       testing_util::RunFinecap("info --capture " + dense() + " --mesh " + mesh() + " --threads 1");
   EXPECT_EQ(info.exit_code, 0) << info.output;
   EXPECT_NE(info.output.find("COLMAP binary model in sparse"), std::string::npos) << info.output;
+}
+
+// COLMAP's masks of its flat layout, masks/NAME.png for images/NAME, are the capture's masks: each
+// camera's reads back as written (foreground where non-zero); a missing one is named.
+TEST_F(ColmapWorkspaceTest, ReadsColmapMasksOfFlatImages) {
+  const Capture plain = Capture::Open(workspace(), mesh());
+  EXPECT_FALSE(plain.has_masks());
+  fs::create_directories(workspace() + "/masks");
+  std::vector<cv::Mat> written;
+  for (int c = 0; c < plain.num_cameras(); ++c) {
+    const Camera& camera = plain.cameras()[c];
+    cv::Mat mask(camera.height, camera.width, CV_8UC1, cv::Scalar(0));
+    mask(cv::Rect(camera.width / 4, camera.height / 4 + c, camera.width / 2, camera.height / 3))
+        .setTo(1);  // COLMAP's masks may hold any non-zero value on the subject.
+    ASSERT_TRUE(cv::imwrite(workspace() + "/masks/" + camera.name + ".png.png", mask));
+    written.push_back(mask);
+  }
+  Capture masked = Capture::Open(workspace(), mesh());
+  ASSERT_TRUE(masked.has_masks());
+  for (int c = 0; c < masked.num_cameras(); ++c) {
+    SCOPED_TRACE(masked.cameras()[c].name);
+    const cv::Mat read = masked.ReadMask(c, 0);
+    EXPECT_EQ(cv::countNonZero((read != 0) != (written[c] != 0)), 0);
+  }
+  fs::remove(workspace() + "/masks/cam01.png.png");
+  ExpectErrorMentions([&] { Capture::Open(workspace(), mesh()); },
+                      {workspace() + "/masks/cam01.png.png", "mask not found"});
 }
 
 TEST_F(ColmapWorkspaceTest, BadWorkspacesNameTheFileAndTheProblem) {

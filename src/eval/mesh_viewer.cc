@@ -183,7 +183,8 @@ std::string ScriptSafe(std::string script) {
 template <typename Value>
 std::string Base64Of(const std::vector<Value>& values) {
   std::string bytes(values.size() * sizeof(Value), '\0');
-  std::memcpy(bytes.data(), values.data(), bytes.size());
+  // An empty vector's data() may be null, which memcpy must not be given even for no bytes.
+  if (!bytes.empty()) std::memcpy(bytes.data(), values.data(), bytes.size());
   return Base64Encode(bytes);
 }
 

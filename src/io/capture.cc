@@ -193,6 +193,11 @@ void Capture::ReadCameras(const std::vector<std::string>& colmap_images) {
     const std::string colmap_image = colmap_images.empty() ? "" : colmap_images[c];
     streams_.push_back(RequireCameraStream(FindCameraStream(camera, colmap_image), camera,
                                            colmap_image, rig_source_, directory_));
+    std::error_code error;
+    flat_image_names_.push_back(
+        streams_.back() == colmap_image
+            ? fs::relative(colmap_image, fs::path(directory_) / "images", error).string()
+            : "");
     Require(streams_.back() != colmap_image || num_frames() == 1, colmap_image,
             "a single image (COLMAP's flat images/ layout) holds one frame, but the capture has " +
                 std::to_string(num_frames()) + " meshes");
@@ -220,9 +225,19 @@ void Capture::OpenFrameSources() {
 void Capture::OpenMaskSources() {
   const std::string folder = FindMaskFolder(directory_);
   if (folder.empty()) return;
-  for (const Camera& camera : rig_) {
+  for (size_t c = 0; c < rig_.size(); ++c) {
+    const Camera& camera = rig_[c];
     const fs::path camera_folder = fs::path(folder) / camera.name;
     std::error_code error;
+    if (!flat_image_names_[c].empty() && !fs::is_directory(camera_folder, error)) {
+      // COLMAP's layout: the mask of images/NAME is masks/NAME.png.
+      const std::string mask = (fs::path(folder) / (flat_image_names_[c] + ".png")).string();
+      Require(fs::is_regular_file(mask, error), mask,
+              "mask not found: with " + folder + " every image needs its mask (COLMAP's masks/" +
+                  flat_image_names_[c] + ".png, or masks/" + camera.name + "/)");
+      mask_sources_.push_back(MakeMaskFileSource(mask, camera));
+      continue;
+    }
     Require(fs::is_directory(camera_folder, error), camera_folder.string(),
             "mask folder not found: with " + folder + " every camera needs its masks");
     mask_sources_.push_back(MakeMaskFolderSource(camera_folder.string(), frame_names_, camera));

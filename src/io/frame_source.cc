@@ -144,6 +144,18 @@ void RequireFrameInRange(int frame, int num_frames, const std::string& where) {
           "frame " + std::to_string(frame) + " is outside [0, " + std::to_string(num_frames) + ")");
 }
 
+// The mask at `path` of `camera`, undistorted by `undistorter` (ForegroundOf;
+// MakeMaskFolderSource).
+cv::Mat ReadMaskFile(const std::string& path, const Camera& camera,
+                     const Undistorter& undistorter) {
+  const std::string bytes = internal::ReadWholeFile(path);
+  const cv::Mat mask = ForegroundOf(DecodeImageBytes(bytes, path), IsJpeg(bytes));
+  Require(mask.cols == camera.width && mask.rows == camera.height, path,
+          "the mask is " + SizeText(mask.cols, mask.rows) + " but camera " + camera.name +
+              "'s images are " + SizeText(camera.width, camera.height));
+  return undistorter.Apply(mask, cv::INTER_NEAREST);
+}
+
 // The images of a folder, or its masks (ForegroundOf), one frame at a time.
 class ImageFolderSource : public FrameSource {
  public:
@@ -161,7 +173,7 @@ class ImageFolderSource : public FrameSource {
   cv::Mat Read(int frame) override {
     RequireFrameInRange(frame, num_frames(), folder_);
     const std::string path = index_.Find(frame_names_[frame]);
-    if (content_ == Content::kMasks) return ReadMask(path);
+    if (content_ == Content::kMasks) return ReadMaskFile(path, camera_, undistorter_);
     const cv::Mat image = DecodeImageFile(path);
     RequireCameraSize(image, camera_, path);
     return undistorter_.Apply(image);
@@ -170,15 +182,6 @@ class ImageFolderSource : public FrameSource {
   int num_frames() const override { return static_cast<int>(frame_names_.size()); }
 
  private:
-  cv::Mat ReadMask(const std::string& path) const {
-    const std::string bytes = internal::ReadWholeFile(path);
-    const cv::Mat mask = ForegroundOf(DecodeImageBytes(bytes, path), IsJpeg(bytes));
-    Require(mask.cols == camera_.width && mask.rows == camera_.height, path,
-            "the mask is " + SizeText(mask.cols, mask.rows) + " but camera " + camera_.name +
-                "'s images are " + SizeText(camera_.width, camera_.height));
-    return undistorter_.Apply(mask, cv::INTER_NEAREST);
-  }
-
   std::string folder_;
   ImageFolderIndex index_;
   std::vector<std::string> frame_names_;
@@ -187,14 +190,15 @@ class ImageFolderSource : public FrameSource {
   Content content_;
 };
 
-// One image file, the only frame: COLMAP's flat images/NAME layout.
+// One image file, the only frame: COLMAP's flat images/NAME layout, or its mask masks/NAME.png.
 class ImageFileSource : public FrameSource {
  public:
-  ImageFileSource(const std::string& path, const Camera& camera)
-      : path_(path), camera_(camera), undistorter_(camera) {}
+  ImageFileSource(const std::string& path, const Camera& camera, bool mask = false)
+      : path_(path), camera_(camera), undistorter_(camera), mask_(mask) {}
 
   cv::Mat Read(int frame) override {
     RequireFrameInRange(frame, num_frames(), path_);
+    if (mask_) return ReadMaskFile(path_, camera_, undistorter_);
     const cv::Mat image = DecodeImageFile(path_);
     RequireCameraSize(image, camera_, path_);
     return undistorter_.Apply(image);
@@ -206,6 +210,7 @@ class ImageFileSource : public FrameSource {
   std::string path_;
   Camera camera_;
   Undistorter undistorter_;
+  bool mask_;
 };
 
 bool IsImageFile(const std::string& path) {
@@ -288,6 +293,11 @@ std::unique_ptr<FrameSource> MakeMaskFolderSource(const std::string& folder,
   camera.Validate(folder);
   return std::make_unique<ImageFolderSource>(folder, frame_names, camera,
                                              ImageFolderSource::Content::kMasks);
+}
+
+std::unique_ptr<FrameSource> MakeMaskFileSource(const std::string& path, const Camera& camera) {
+  camera.Validate(path);
+  return std::make_unique<ImageFileSource>(path, camera, true);
 }
 
 std::unique_ptr<FrameSource> MakeVideoSource(const std::string& path, int num_frames,

@@ -24,7 +24,9 @@
 // nor videos/<camera>.* takes the image that posed it, images/NAME (COLMAP's flat layout, where
 // NAME is `cam03.jpg` and the camera `cam03`): one image per camera, so the capture holds one
 // frame. Its mesh is the one given to Open, else meshes/ as above, else, in COLMAP's undistorted
-// dense/0/ folder, the one meshed-*.ply there (meshed-poisson.ply, meshed-delaunay.ply).
+// dense/0/ folder, the one meshed-*.ply there (meshed-poisson.ply, meshed-delaunay.ply). Its masks,
+// when it has a masks/ folder, are COLMAP's: masks/NAME.png (masks/cam03.jpg.png), where a camera
+// has no masks/<camera>/ folder.
 #ifndef FINECAP_CAPTURE_H_
 #define FINECAP_CAPTURE_H_
 
@@ -132,6 +134,9 @@ class Capture {
   std::vector<std::string> mesh_paths_;
   Mesh first_mesh_;
   std::vector<std::string> streams_;  // Per camera, its image folder, video or single image.
+  // Per camera, the name of its one image in a COLMAP model (relative to images/) when it is
+  // read from COLMAP's flat layout; empty otherwise.
+  std::vector<std::string> flat_image_names_;
   std::vector<std::unique_ptr<FrameSource>> sources_;
   // Per camera, its image of frame 0, decoded as the capture opened to check it: the first
   // ReadImage of that frame takes it instead of decoding it again, and a read of any other frame

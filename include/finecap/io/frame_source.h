@@ -49,6 +49,10 @@ std::unique_ptr<FrameSource> MakeMaskFolderSource(const std::string& folder,
                                                   const std::vector<std::string>& frame_names,
                                                   const Camera& camera);
 
+// The mask file at `path` as the one frame, read as MakeMaskFolderSource reads each: COLMAP's
+// masks/NAME.png of its flat images/NAME layout.
+std::unique_ptr<FrameSource> MakeMaskFileSource(const std::string& path, const Camera& camera);
+
 // Frame i is the i-th frame of the video at `path` (anything cv::VideoCapture opens), for
 // `num_frames` frames. OpenCV's video input is loaded here, on the first video opened, from
 // libfinecap_opencv_extras.so; Error names that library when it cannot be loaded. Frames asked in
