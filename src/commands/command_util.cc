@@ -209,10 +209,6 @@ class ConsoleObserver : public SequenceObserver {
   Progress progress_;
 };
 
-}  // namespace
-
-namespace {
-
 // Below this share of vertices refined with confidence, a run says that its capture cannot be
 // refined usefully: most of the surface then stays near the input, for want of views.
 constexpr double kUsefulConfidentShare = 0.5;

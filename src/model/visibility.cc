@@ -117,10 +117,11 @@ std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
     const auto views = ViewsOf(cameras, points.col(p), normals.col(p), visible, p);
     if (static_cast<int>(views.size()) < wanted) continue;
     const double cosine = views[wanted - 1].first;
-    confidence[p] = cosine >= full ? 1.0f
-                    : full > none
-                        ? static_cast<float>(std::max(0.0, (cosine - none) / (full - none)))
-                        : 0.0f;
+    if (cosine >= full) {
+      confidence[p] = 1.0f;
+    } else if (full > none) {  // Without a fallback (the two angles equal) a steeper view is 0.
+      confidence[p] = static_cast<float>(std::max(0.0, (cosine - none) / (full - none)));
+    }
   }
   return confidence;
 }
