@@ -81,6 +81,21 @@ SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
   return scene;
 }
 
+// The k, the same for every surface Gaussian, within 3 mm of the grid in steps of 0.1 mm, at
+// which `energy`'s similarity is highest.
+double BestUniformDisplacement(const FrameEnergy& energy) {
+  double best_k = 0.0, best = -std::numeric_limits<double>::infinity();
+  for (double k = -0.003; k <= 0.003; k += 0.0001) {
+    const double value = energy.similarity().Evaluate(
+        Eigen::VectorXd::Constant(energy.num_parameters(), k), nullptr);
+    if (value > best) {
+      best = value;
+      best_k = k;
+    }
+  }
+  return best_k;
+}
+
 EnergyOptions SampledOptions() {
   EnergyOptions options;
   options.similarity = SimilarityType::kConsensus;
@@ -225,16 +240,7 @@ TEST(PixelConsensusTest, UniformDisplacementIsBestAtTheTruePlane) {
     const SampledScene scene = MakeSampledScene(truth);
     FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                        scene.samples);
-    double best_k = 0.0, best = -std::numeric_limits<double>::infinity();
-    for (double k = -0.003; k <= 0.003; k += 0.0001) {
-      const double value = energy.similarity().Evaluate(
-          Eigen::VectorXd::Constant(energy.num_parameters(), k), nullptr);
-      if (value > best) {
-        best = value;
-        best_k = k;
-      }
-    }
-    EXPECT_NEAR(best_k, truth, 0.00015) << "truth " << truth;
+    EXPECT_NEAR(BestUniformDisplacement(energy), truth, 0.00015) << "truth " << truth;
   }
 }
 
@@ -257,6 +263,51 @@ TEST(PixelConsensusTest, PatchShapeMovesTheSamplesByTheBlendedShape) {
   term.SetPatchShape(tilted);
   EXPECT_GT(std::abs(term.Evaluate(k, nullptr) - unshaped), 1e-6 * std::abs(unshaped));
   EXPECT_THROW(term.SetPatchShape(Eigen::VectorXd::Zero(n + 1)), Error);
+}
+
+// A foreground mask cuts the patches along a silhouette; it does not drop them. Here the first
+// camera's foreground holds only the grid's half x < 0: each patch across the cut is still
+// compared by all three cameras, on its samples in that half, and a patch beyond it by the other
+// two, whole. The cut patches keep the similarity exact and best at the true plane.
+TEST(PixelConsensusTest, AMaskCutsPatchesAlongItsEdgeInsteadOfDroppingThem) {
+  const double truth = 0.0011;
+  SampledScene scene = MakeSampledScene(truth);
+  const FrameEnergy whole(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                          scene.samples);
+  auto& foreground = scene.cameras[0].samples_on_foreground;
+  foreground.assign(scene.samples.size(), 0);
+  for (int j = 0; j < scene.samples.size(); ++j) foreground[j] = scene.samples.base(0, j) < 0.0;
+  const FrameEnergy cut(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                        scene.samples);
+  const auto& whole_blocks = whole.similarity().residual_blocks();
+  const auto& cut_blocks = cut.similarity().residual_blocks();
+  ASSERT_EQ(cut_blocks.size(), whole_blocks.size());
+  int shrunk = 0, two_cameras = 0;
+  for (size_t b = 0; b < cut_blocks.size(); ++b) {
+    ASSERT_EQ(cut_blocks[b].parameters, whole_blocks[b].parameters);
+    const int whole_residuals = whole_blocks[b].num_residuals;
+    const int cut_residuals = cut_blocks[b].num_residuals;
+    EXPECT_LE(cut_residuals, whole_residuals);
+    two_cameras += 3 * cut_residuals == 2 * whole_residuals;
+    shrunk += cut_residuals < whole_residuals && 3 * cut_residuals != 2 * whole_residuals;
+  }
+  EXPECT_GT(shrunk, 0);
+  EXPECT_GT(two_cameras, 0);
+
+  const Eigen::VectorXd k = RandomK(cut.num_parameters(), 0.002, 5);
+  Eigen::VectorXd analytic;
+  cut.Evaluate(k, &analytic);
+  const Eigen::VectorXd numeric =
+      NumericGradient([&](const Eigen::VectorXd& x) { return cut.Evaluate(x, nullptr); }, k, 1e-8);
+  EXPECT_LE((analytic - numeric).cwiseAbs().maxCoeff(), 1e-4 * numeric.cwiseAbs().maxCoeff());
+
+  EXPECT_NEAR(BestUniformDisplacement(cut), truth, 0.00015);
+
+  // A foreground of the wrong size is refused.
+  foreground.pop_back();
+  EXPECT_THROW(FrameEnergy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                           scene.samples),
+               Error);
 }
 
 }  // namespace

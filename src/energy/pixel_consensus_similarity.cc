@@ -62,6 +62,9 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
             camera.camera.name, "the samples need the camera's image, converted (CV_32FC3)");
     Require(camera.samples_visible.size() == static_cast<size_t>(samples.size()),
             camera.camera.name, "visibility must have one flag per surface sample");
+    Require(camera.samples_on_foreground.empty() ||
+                camera.samples_on_foreground.size() == static_cast<size_t>(samples.size()),
+            camera.camera.name, "the foreground must have one flag per surface sample, or none");
   }
   // Patches added in the order of their centres in space, so that the blocks a thread evaluates
   // one after the other read the same rows of the images and mostly the same samples: the reads
@@ -75,16 +78,52 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
   for (int s : SpatialOrder(centres)) {
     const std::vector<int>& patch = samples.patches[s];
     if (static_cast<int>(patch.size()) < kMinPatchSamples) continue;
-    std::vector<int> seen_by;
-    for (size_t c = 0; c < cameras.size(); ++c) {
-      const auto unseen = [&](int j) { return cameras[c].samples_visible[j] == 0; };
-      if (std::none_of(patch.begin(), patch.end(), unseen)) seen_by.push_back(static_cast<int>(c));
-    }
-    if (static_cast<int>(seen_by.size()) >= options_.min_cameras) AddPatch(s, patch, seen_by);
+    std::vector<int> seen_by, members;
+    ComparablePart(patch, &seen_by, &members);
+    if (static_cast<int>(seen_by.size()) >= options_.min_cameras) AddPatch(s, members, seen_by);
   }
   shape_ = Eigen::VectorXd::Zero(samples.size());
   parameter_shape_ = Eigen::VectorXd::Zero(samples.patches.size());
   WeighPatches();
+}
+
+void PixelConsensusSimilarity::ComparablePart(const std::vector<int>& patch,
+                                              std::vector<int>* seen_by,
+                                              std::vector<int>* members) const {
+  // Occlusion takes a camera from the whole patch: a hidden sample would compare what lies in
+  // front of it. A mask only takes pixels out, and along a silhouette it cuts the patches at the
+  // subject's edge in every camera, so a cut patch is compared on its samples that lie on the
+  // foreground of every camera comparing it. Cameras with most of the patch on their foreground
+  // are taken first; one that would leave too few samples for a shape (kMinPatchSamples) is left
+  // out.
+  const int size = static_cast<int>(patch.size());
+  std::vector<std::pair<int, int>> candidates;  // (samples off the foreground, camera)
+  for (int c = 0; c < static_cast<int>(cameras_.size()); ++c) {
+    const CameraInput& camera = cameras_[c];
+    const auto unseen = [&](int j) { return camera.samples_visible[j] == 0; };
+    if (std::any_of(patch.begin(), patch.end(), unseen)) continue;
+    const auto off = [&](int j) {
+      return !camera.samples_on_foreground.empty() && camera.samples_on_foreground[j] == 0;
+    };
+    candidates.push_back({static_cast<int>(std::count_if(patch.begin(), patch.end(), off)), c});
+  }
+  std::stable_sort(candidates.begin(), candidates.end());
+  std::vector<unsigned char> kept(patch.size(), 1);
+  int num_kept = size;
+  for (const auto& [num_off, c] : candidates) {
+    const std::vector<unsigned char>& foreground = cameras_[c].samples_on_foreground;
+    const auto cut = [&](int m) { return !foreground.empty() && foreground[patch[m]] == 0; };
+    int remaining = num_kept;
+    for (int m = 0; m < size; ++m) remaining -= kept[m] != 0 && cut(m);
+    if (remaining < kMinPatchSamples) continue;
+    for (int m = 0; m < size; ++m) kept[m] = kept[m] != 0 && !cut(m);
+    num_kept = remaining;
+    seen_by->push_back(c);
+  }
+  std::sort(seen_by->begin(), seen_by->end());
+  for (int m = 0; m < size; ++m) {
+    if (kept[m] != 0) members->push_back(patch[m]);
+  }
 }
 
 void PixelConsensusSimilarity::SampleColor(int c, int j, double k, double* color,

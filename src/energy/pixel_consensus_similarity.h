@@ -48,6 +48,11 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
 
  private:
   void PatchColors(int b, double k, double* colors, double* derivatives) const override;
+  // The cameras that compare `patch` (ascending) and the samples of it they compare: the cameras
+  // that see the whole patch, and of its samples those on the foreground of each of them
+  // (CameraInput::samples_on_foreground); with no masks, every camera that sees it, on all of it.
+  void ComparablePart(const std::vector<int>& patch, std::vector<int>* seen_by,
+                      std::vector<int>* members) const;
   // Writes camera c's colour of sample j displaced by k along its normal (three channels) to
   // `color` and, when `derivative` is not null, dcolour/dk to it.
   void SampleColor(int c, int j, double k, double* color, double* derivative) const;

@@ -191,10 +191,17 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
   frame.normals = ComputeVertexNormals(frame.fine);
-  frame.visible =
-      ComputeFrameVisibility(frame.fine, frame.normals, input.cameras, options.visibility,
-                             FallbackCamerasWanted(options), input.masks);
-  const auto& visible = frame.visible;
+  // Which cameras see each vertex by the geometry alone: where the input is off by a few pixels
+  // at a silhouette its vertex falls on the background, yet the surface it stands for is seen,
+  // so the detail stage (whose samples each meet the masks where they read) and the confidence
+  // start from this. The image-model stage compares each surface Gaussian where its vertex
+  // projects, so there a camera sees a vertex only on its foreground (FrameInput).
+  frame.visible = ComputeFrameVisibility(frame.fine, frame.normals, input.cameras,
+                                         options.visibility, FallbackCamerasWanted(options));
+  std::vector<std::vector<unsigned char>> visible = frame.visible;
+  for (size_t c = 0; c < input.masks.size(); ++c) {
+    KeepForeground(input.cameras[c], input.masks[c], frame.fine.vertices, 0, &visible[c]);
+  }
   frame.images = std::move(images);
 
   // The consensus similarity compares the cameras of this frame with each other; the colours
@@ -210,7 +217,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
                                                   model.refined_vertices(), frame_colors);
   const std::vector<float> view_confidence =
       ViewConfidence(input.cameras, frame.fine.vertices, frame.normals, CamerasWanted(options),
-                     options.visibility, visible);
+                     options.visibility, frame.visible);
   for (int v : surface.vertex_ids) surface.view_confidence.push_back(view_confidence[v]);
   surface.input_offset =
       InputOffsets(model, input.coarse, frame.fine, frame.normals, surface.vertex_ids);
@@ -268,8 +275,9 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
     cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
     if (!input.masks.empty()) {
+      cameras[c].samples_on_foreground.assign(samples.size(), 1);
       KeepForeground(input.cameras[c], input.masks[c], samples.base, SampleReach(consensus),
-                     &cameras[c].samples_visible);
+                     &cameras[c].samples_on_foreground);
     }
     cameras[c].pixels = pixels[c];
   }
@@ -401,7 +409,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     PrepareDetailEnergy(model, input, options, &frame);
     result.seconds_preparation += frame.seconds - seconds;
     ShapePatchesLike(k, options, frame.energy.get());
-    SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
+      SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
     EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,
                           &summary.ls_cost_start);
     summary.AddWork(result.summary);

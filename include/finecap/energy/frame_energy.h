@@ -33,6 +33,10 @@ struct CameraInput {
   // flag per sample).
   cv::Mat pixels;
   std::vector<unsigned char> samples_visible;
+  // With a foreground mask: which samples read only the camera's foreground (one flag per
+  // sample); empty when the camera has no mask. A sample off it is left out of the patches this
+  // camera compares, not the whole patch (PixelConsensusSimilarity).
+  std::vector<unsigned char> samples_on_foreground;
 };
 
 // Points of the surface about a pixel apart at which a similarity reads the images at their own

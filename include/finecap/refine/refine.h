@@ -120,18 +120,23 @@ struct RefineOptions {
 // One frame's input: the coarse mesh and, per camera, the pinhole camera and its undistorted
 // 8-bit BGR image, and optionally its foreground mask.
 //
-// Masks. Background pixels take no part in the energy, in two ways that together leave the
-// result unchanged whatever the background holds: the image models are built from foreground
-// pixels only (BuildImageGaussians), so no image Gaussian carries a background colour; and a
-// camera sees a vertex only where the vertex projects onto its foreground (ComputeFrameVisibility),
+// Masks. Background pixels take no part in the energy, in ways that together leave the result
+// unchanged whatever the background holds: the image models are built from foreground pixels
+// only (BuildImageGaussians), so no image Gaussian carries a background colour; and in the
+// image-model stage a camera sees a vertex only where the vertex projects onto its foreground,
 // so a surface Gaussian that falls on the background in one camera is compared in the others
 // alone, not against the absence of image Gaussians there. What reads pixels directly (the
 // detail stage's samples, reference colours from pixels) reads the images with their background
 // painted black, so that no blur or bilinear read near a silhouette takes anything from what the
-// background holds; and the detail stage's samples are dropped, as vertices are, where they
-// fall on a mask shrunk by the reach of their reads (PrepareDetailEnergy), so that they do not
-// read that black either. Dropping, rather than down-weighting, keeps the energy's form: each
-// term is whole or absent.
+// background holds; and a detail sample counts as off a camera's foreground where it falls on
+// the mask shrunk by the reach of its reads (PrepareDetailEnergy), so that it does not read
+// that black either. A patch cut by a mask is compared on its samples that every camera
+// comparing it has on its foreground (PixelConsensusSimilarity), not dropped: along a
+// silhouette every camera cuts the patches at the subject's edge, and dropping them left a band
+// along the hem of a skirt without data. Which cameras see a vertex at all, for the detail
+// stage and the confidence, is decided by the geometry alone: the input may be off by a few
+// pixels at a silhouette, where its vertex then falls on the background of a camera that does
+// see the surface it stands for.
 struct FrameInput {
   Mesh coarse;
   std::vector<Camera> cameras;
@@ -232,7 +237,8 @@ ReferenceColors ComputeSurfaceColors(const Mesh& fine, const FrameInput& frame,
 struct PreparedFrame {
   Mesh fine;                 // The subdivided input mesh.
   Eigen::Matrix3Xd normals;  // Its unit normals, along which k displaces.
-  // Per camera, which vertices of `fine` it sees (ComputeVisibility).
+  // Per camera, which vertices of `fine` it sees by the geometry alone, whatever the masks say
+  // (ComputeFrameVisibility).
   std::vector<std::vector<unsigned char>> visible;
   // One per camera, while the energy refers to them: none once it is built when its similarity
   // reads no pair list after (SimilarityTerm::ReadsPairLists; the consensus similarity's tables
