@@ -1,9 +1,12 @@
 #include "energy/input_prior.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "energy_fixture.h"
 #include "finecap/solvers/solver.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
@@ -163,6 +166,45 @@ TEST(InputPriorEnergyTest, ScalarGradientAndLeastSquaresFormAgree) {
         [&](const Eigen::VectorXd& x) { return energy.Evaluate(x, nullptr); }, k, 1e-7);
     EXPECT_LT((gradient - numeric).norm(), 1e-5 * gradient.norm());
   }
+}
+
+// A second pull (energy.temporal_weight's, towards the frame before) joins the prior as one
+// quadratic per k_s: the energy drops by exactly 1/2 w H (k_s - target_s)^2 over the finite
+// targets, H the median data curvature, for every k; the least-squares form follows it.
+TEST(InputPriorEnergyTest, AddedPullJoinsThePriorAsOneQuadratic) {
+  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 9);
+  const Eigen::VectorXd offsets = RandomK(scene.surface.size(), 0.002, 11);
+  scene.surface.input_offset.assign(offsets.data(), offsets.data() + offsets.size());
+  const FrameEnergy plain(scene.surface, scene.cameras, scene.neighbourhoods,
+                          SurfaceColorOptions(50));
+  FrameEnergy pulled(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(50));
+  const int n = pulled.num_parameters();
+  Eigen::VectorXd target = RandomK(n, 0.003, 12);
+  target[1] = std::nan("");  // A vertex the frame before did not refine: not pulled.
+  const double weight = 2.0;
+  pulled.AddPull(target, weight);
+  const double h = MedianOfPositive(DataCurvature(&pulled.similarity(), Eigen::VectorXd::Zero(n)));
+  ASSERT_GT(h, 0.0);
+  EXPECT_EQ(pulled.prior_curvature()[1], plain.prior_curvature()[1]);
+  EXPECT_EQ(pulled.prior_target()[1], plain.prior_target()[1]);
+  EXPECT_NEAR(pulled.prior_curvature()[0], plain.prior_curvature()[0] + weight * h,
+              1e-12 * pulled.prior_curvature()[0]);
+
+  double constant = std::nan("");
+  for (unsigned seed : {20u, 21u, 22u}) {
+    const Eigen::VectorXd k = RandomK(n, 0.004, seed);
+    double pull = 0.0;
+    for (int s = 0; s < n; ++s) {
+      if (std::isfinite(target[s])) pull += 0.5 * weight * h * std::pow(k[s] - target[s], 2);
+    }
+    const double before = plain.Evaluate(k, nullptr), after = pulled.Evaluate(k, nullptr);
+    // The blend of two quadratics is one quadratic plus a constant: the same at every k.
+    const double difference = before - after - pull;
+    if (std::isnan(constant)) constant = difference;
+    EXPECT_NEAR(difference, constant, 1e-9 * std::abs(after));
+    EXPECT_NEAR(LeastSquaresCost(&pulled, k), -after, 1e-9 * std::abs(after));
+  }
+  EXPECT_THROW(pulled.AddPull(Eigen::VectorXd::Zero(n + 1), 1.0), Error);
 }
 
 }  // namespace

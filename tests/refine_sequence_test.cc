@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,8 @@
 #include "finecap/geometry/subdivision.h"
 #include "finecap/io/mesh_io.h"
 #include "finecap/refine/frame_stats.h"
+#include "finecap/refine/refine.h"
+#include "finecap/refine/run_folder.h"
 #include "finecap/synth/synth.h"
 #include "finecap/util/atomic_file.h"
 #include "finecap/util/error.h"
@@ -57,7 +60,8 @@ TEST(RefineSequenceTest, TheFrameAfterAKeptInputStartsWhereAFirstFrameStarts) {
   config.refine.bias_compensation = true;
   config.refine.keep_input_if_worse = true;
   config.refine.warm_start = true;
-  config.refine.sweep.samples = 0;  // A frame without a predecessor starts at zero.
+  config.refine.energy.temporal_weight = 0.0;  // Its pull would be in frame 1's energy too.
+  config.refine.sweep.samples = 0;             // A frame without a predecessor starts at zero.
   ASSERT_EQ(RunRefine(config), 0);
   ASSERT_TRUE(Record(config.output.dir, "000000").kept_input);
 
@@ -210,6 +214,66 @@ TEST(RefineSequenceTest, FlickerFollowsTheFrameBeforeAcrossResumesAndShards) {
     EXPECT_NEAR(actual.flicker_refined_mm, expected.flicker_refined_mm, 1e-9) << frame;
     EXPECT_NEAR(actual.flicker_subdivided_mm, expected.flicker_subdivided_mm, 1e-9) << frame;
     EXPECT_NEAR(actual.flicker_coarse_mm, expected.flicker_coarse_mm, 1e-9) << frame;
+  }
+}
+
+// The RMS over the vertices refined in both of the change of k from frame `before` to `after`
+// in the run folder `out`, metres.
+double ChangeOfK(const std::string& out, const std::string& before, const std::string& after,
+                 int num_vertices) {
+  const Eigen::VectorXd a =
+      ReadDisplacement(FrameFilesIn(out, before, MeshFormat::kPly).displacement, num_vertices);
+  const Eigen::VectorXd b =
+      ReadDisplacement(FrameFilesIn(out, after, MeshFormat::kPly).displacement, num_vertices);
+  double sum2 = 0.0;
+  int count = 0;
+  for (int v = 0; v < num_vertices; ++v) {
+    if (!std::isfinite(a[v]) || !std::isfinite(b[v])) continue;
+    sum2 += (b[v] - a[v]) * (b[v] - a[v]);
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum2 / count) : std::nan("");
+}
+
+// energy.temporal_weight pulls each frame's k towards the frame before's: k changes less from
+// frame to frame. The pull reads the frame before from its saved files, so frame 1 resumed and
+// frame 2 refined by a run of its own give what one run gives.
+TEST(RefineSequenceTest, TheTemporalPullHoldsEachFrameNearerTheFrameBefore) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_temporal");
+  Capture capture = OpenTinyCapture(root, 3);
+  const int num_vertices =
+      SequenceModel(capture.ReadCoarseMesh(0), {}, QuickOptions().refine, "test")
+          .num_fine_vertices();
+  SequenceOptions free_options = QuickOptions(), pulled_options = QuickOptions();
+  free_options.refine.energy.temporal_weight = 0.0;
+  pulled_options.refine.energy.temporal_weight = 20.0;
+  const std::string free = root + "/free", pulled = root + "/pulled", parts = root + "/parts";
+  RefineSequence(&capture, {0, 3}, free_options, free);
+  RefineSequence(&capture, {0, 3}, pulled_options, pulled);
+  for (const auto& [before, after] :
+       {std::pair<std::string, std::string>{"000000", "000001"}, {"000001", "000002"}}) {
+    const double free_change = ChangeOfK(free, before, after, num_vertices);
+    const double pulled_change = ChangeOfK(pulled, before, after, num_vertices);
+    EXPECT_GT(free_change, 0.0) << after;
+    EXPECT_LT(pulled_change, 0.5 * free_change) << after;
+  }
+  // Frame 0 has no frame before: the pull leaves it as it was.
+  EXPECT_EQ(FileBytes(FrameFilesIn(pulled, "000000", MeshFormat::kPly).displacement),
+            FileBytes(FrameFilesIn(free, "000000", MeshFormat::kPly).displacement));
+
+  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
+    RefineSequence(&capture, part, pulled_options, parts);
+  }
+  for (const std::string frame : {"000001", "000002"}) {
+    const Eigen::VectorXd whole_k =
+        ReadDisplacement(FrameFilesIn(pulled, frame, MeshFormat::kPly).displacement, num_vertices);
+    const Eigen::VectorXd parts_k =
+        ReadDisplacement(FrameFilesIn(parts, frame, MeshFormat::kPly).displacement, num_vertices);
+    EXPECT_LT(
+        (whole_k - parts_k).array().isFinite().select(whole_k - parts_k, 0.0).cwiseAbs().maxCoeff(),
+        1e-9)
+        << frame;
   }
 }
 

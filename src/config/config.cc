@@ -276,6 +276,11 @@ void AddEnergyKeys(EnergyOptions* energy, SceneLengths* scene_lengths, ConfigSch
                     "decide it (few cameras, steep views, wide plain regions), in units of the "
                     "median data curvature (not in the paper; 0: off).",
                     0.0, 1e6);
+  schema->AddDouble("energy.temporal_weight", &energy->temporal_weight,
+                    "Strength of a pull of k towards the frame before's solved k (temporal "
+                    "coherence), in units of the median data curvature (not in the paper; 0: "
+                    "off).",
+                    0.0, 1e6);
   schema->AddDouble("energy.confidence_threshold", &energy->confidence_threshold,
                     "Colour variation, as a fraction of its median, below which the cloth counts "
                     "as plain.",

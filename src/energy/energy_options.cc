@@ -35,6 +35,7 @@ void EnergyOptions::Check() const {
   RequireFieldRange(w_reg, 0.0, 1e12, "EnergyOptions::w_reg");
   RequireFieldRange(w_prior, 0.0, 1e12, "EnergyOptions::w_prior");
   RequireFieldRange(confidence_prior, 0.0, 1e6, "EnergyOptions::confidence_prior");
+  RequireFieldRange(temporal_weight, 0.0, 1e6, "EnergyOptions::temporal_weight");
   RequireFieldRange(confidence_threshold, 1e-9, 1e3, "EnergyOptions::confidence_threshold");
   RequireFieldRange(confidence_opening, 0, 20, "EnergyOptions::confidence_opening");
   RequireFieldRange(reg_rings, 1, 10, "EnergyOptions::reg_rings");

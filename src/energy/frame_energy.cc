@@ -104,6 +104,7 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
   Eigen::VectorXd data_curvature;
   if (options_.confidence_prior > 0.0) {
     data_curvature = DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size()));
+    typical_data_curvature_ = MedianOfPositive(data_curvature);
   }
   prior_curvature_ = PriorCurvature(data_curvature, confidence_, surface_.size(), options_);
   prior_target_ =
@@ -116,6 +117,24 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
     std::vector<int>().swap(view.pairs.image_ids);
     std::vector<float>().swap(view.pairs.color_weights);
     view.image = nullptr;  // Without the ids nothing leads to the image Gaussians.
+  }
+}
+
+void FrameEnergy::AddPull(const Eigen::VectorXd& target, double weight) {
+  Require(target.size() == surface_.size(), "FrameEnergy::AddPull",
+          "one target per surface Gaussian expected");
+  if (typical_data_curvature_ < 0.0) {
+    typical_data_curvature_ =
+        MedianOfPositive(DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size())));
+  }
+  const double p = weight * typical_data_curvature_;
+  if (!(p > 0.0)) return;
+  for (int s = 0; s < surface_.size(); ++s) {
+    if (!std::isfinite(target[s])) continue;
+    // Two quadratics in k_s are one: the curvatures add and the targets blend by them.
+    const double sum = prior_curvature_[s] + p;
+    prior_target_[s] = (prior_curvature_[s] * prior_target_[s] + p * target[s]) / sum;
+    prior_curvature_[s] = sum;
   }
 }
 

@@ -48,10 +48,6 @@ double Median(std::vector<double>* values) {
 
 }  // namespace
 
-namespace {
-
-// The median of the positive entries (0 when there is none): Gaussians no camera sees carry no
-// information about what a typical one is held by.
 double MedianOfPositive(const Eigen::VectorXd& values) {
   std::vector<double> positive;
   for (double value : values) {
@@ -59,6 +55,8 @@ double MedianOfPositive(const Eigen::VectorXd& values) {
   }
   return positive.empty() ? 0.0 : Median(&positive);
 }
+
+namespace {
 
 // Each entry replaced by the largest (`dilate`) or smallest of its neighbourhood's.
 Eigen::VectorXd Morph(const Eigen::VectorXd& values, const std::vector<std::vector<int>>& members,

@@ -24,6 +24,10 @@
 
 namespace finecap {
 
+// The median of the positive entries (0 when there is none): Gaussians no camera sees carry no
+// information about what a typical one is held by.
+double MedianOfPositive(const Eigen::VectorXd& values);
+
 // H_s = sum over the similarity's residuals r of (dr/dk_s)^2 at `k`: the diagonal of the
 // Gauss-Newton approximation of the least-squares cost's Hessian, one entry per parameter.
 Eigen::VectorXd DataCurvature(SimilarityTerm* similarity, const Eigen::VectorXd& k);

@@ -178,13 +178,14 @@ void ScoreInHeldOutViews(const SequenceOptions& options, const SequenceModel& mo
   }
 }
 
-// With refine.warm_start: the solved displacement of the frame before `frame`, which seeds
-// `frame`; empty when that frame is not done in `out` (the frame then starts as a first frame).
-// Always from the saved files, so that a resumed run or a shard seeds its first frame exactly as
-// a run that never stopped seeds every frame.
-Eigen::VectorXd WarmStart(const std::string& out, const Capture& capture, int frame,
-                          const SequenceOptions& options, const SequenceModel& model) {
-  if (!options.refine.warm_start || frame == 0) return {};
+// The solved displacement of the frame before `frame`, which seeds `frame` with
+// refine.warm_start and pulls it with energy.temporal_weight; empty when that frame is not done
+// in `out` (the frame then starts as a first frame). Always from the saved files, so that a
+// resumed run or a shard starts its first frame exactly as a run that never stopped starts every
+// frame.
+Eigen::VectorXd SolvedFrameBefore(const std::string& out, const Capture& capture, int frame,
+                                  const SequenceOptions& options, const SequenceModel& model) {
+  if (frame == 0) return {};
   const FrameFiles previous = FrameFilesIn(out, capture.frame_name(frame - 1), options.mesh_format);
   if (!FrameDone(previous)) return {};
   return ReadSolvedDisplacement(previous, model.num_fine_vertices(), options.refine);
@@ -440,7 +441,12 @@ class SequenceRun {
     const std::vector<CalibratedImage>& held_out = read.held_out;
     const std::vector<SkippedCamera>& skipped = read.skipped;
     ReadAheadAfter(frame, frames);
-    const Eigen::VectorXd warm_start = WarmStart(out_, *capture_, frame, options_, model_);
+    const bool pulled = options_.refine.energy.temporal_weight > 0.0;
+    const Eigen::VectorXd before = options_.refine.warm_start || pulled
+                                       ? SolvedFrameBefore(out_, *capture_, frame, options_, model_)
+                                       : Eigen::VectorXd();
+    const Eigen::VectorXd warm_start = options_.refine.warm_start ? before : Eigen::VectorXd();
+    if (pulled) input.frame_before_k = before;
     const ReferenceColors colors = ColorsFor(frame);
     RefineOptions refine = options_.refine;
     if (prepare_ahead_ && reader_.ReadsAhead()) {

@@ -108,6 +108,16 @@ struct EnergyOptions {
   // (docs/measurements.md, 2026-12-05); where they see it well it holds nothing. surface_color
   // needs 300 (configs/surface_color.yaml): its single colours carry nothing on plain cloth.
   double confidence_prior = 1.0;
+  // Strength of a pull of each k towards the solved k of the frame before (temporal coherence),
+  // in units of the median data curvature, as confidence_prior. The frame before's displacement
+  // along its normal is carried to this frame by the input's own motion: the same k on this
+  // frame's surface. Read from the saved files of that frame (as refine.warm_start is), so that
+  // a resumed run pulls its first frame as an uninterrupted run does; the first frame of a
+  // capture, or one whose predecessor is not done (a shard run beside the one before it), is not
+  // pulled. Not in the paper. 0 turns it off. Default 0.3: it lowers both the error and the
+  // flicker of a noisy capture and holds the other synthetic captures within a few tenths of a
+  // point (docs/measurements.md, 2026-12-05).
+  double temporal_weight = 0.3;
   // The consensus similarity's options.
   ConsensusOptions consensus;
   // Colour variation, as a fraction of its median, below which the cloth counts as plain (the

@@ -85,6 +85,11 @@ class FrameEnergy {
   // c_s, how sure the images are of each k_s (Confidence, input_prior.h); the confidence pull
   // (energy.confidence_prior) holds k_s at the input where it is low.
   const Eigen::VectorXd& confidence() const { return confidence_; }
+  // Adds 1/2 (weight H) (k_s - target_s)^2 to E_prior for every s whose target_s is finite, with
+  // H the median of the positive data curvatures at the input, so that `weight` is in the data's
+  // own units as energy.confidence_prior is. Two pulls on one k_s are one: their curvatures add
+  // and their targets blend by them, so the solvers see the same quadratic prior as before.
+  void AddPull(const Eigen::VectorXd& target, double weight);
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 
@@ -104,6 +109,7 @@ class FrameEnergy {
   Eigen::VectorXd prior_curvature_;
   Eigen::VectorXd prior_target_;
   Eigen::VectorXd confidence_;
+  double typical_data_curvature_ = -1.0;  // H of AddPull; below 0 until measured.
   long num_pairs_ = 0;
 };
 
