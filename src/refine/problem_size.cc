@@ -1,7 +1,5 @@
 #include "finecap/refine/problem_size.h"
 
-#include "energy/consensus_similarity.h"
-
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -9,6 +7,7 @@
 #include <glog/logging.h>
 
 #include "finecap/energy/frame_energy.h"
+#include "finecap/energy/similarity_needs.h"
 #include "finecap/model/gaussian_pairs.h"
 #include "finecap/util/error.h"
 #include "refine/surface_sampling.h"
@@ -149,14 +148,13 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     size.num_pixels += double(frame.cameras[c].width) * frame.cameras[c].height;
   }
 
-  const bool consensus = options.energy.similarity == SimilarityType::kConsensus;
-  const bool sampled = consensus && options.energy.consensus.sample_spacing > 0.0;
-  double per_frame = size.num_pairs * (sampled     ? kBytesPerConsensusPairWithSamples
-                                       : consensus ? kBytesPerConsensusPair
-                                                   : kBytesPerPair);
-  if (consensus) {
+  const SimilarityNeeds needs = NeedsOf(options.energy);
+  const bool patches = needs.compares_patches, sampled = needs.reads_surface_samples;
+  double per_frame = size.num_pairs * (sampled   ? kBytesPerConsensusPairWithSamples
+                                       : patches ? kBytesPerConsensusPair
+                                                 : kBytesPerPair);
+  if (const int nodes = ColorTableNodes(options.energy, options.sigma_hat); nodes > 0) {
     // Its colour tables: value and derivative, 3 floats each, per node.
-    const int nodes = ConsensusSimilarity::NumTableNodes(options.sigma_hat, options.energy.k_max);
     per_frame += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation);
   }
   double detail_bytes = 0.0, detail_seconds = 0.0;

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "finecap/energy/frame_energy.h"
+#include "finecap/energy/similarity_needs.h"
 #include "finecap/geometry/render.h"
 #include "finecap/util/error.h"
 #include "refine/foreground.h"
@@ -37,8 +38,7 @@ std::vector<int> FineMaskIds(const SubdivisionStencil& stencil, const std::vecto
 
 // Whether a frame is solved a second time with the images read at their own resolution.
 bool UsesSurfaceSamples(const RefineOptions& options) {
-  return options.energy.similarity == SimilarityType::kConsensus &&
-         options.energy.consensus.sample_spacing > 0.0;
+  return NeedsOf(options.energy).reads_surface_samples;
 }
 
 // Pixels about a surface sample (at its nearest pixel) that its reads take colour from: the
@@ -136,13 +136,12 @@ std::vector<std::vector<unsigned char>> ComputeFrameVisibility(
 }
 
 int CamerasWanted(const RefineOptions& options) {
-  return options.energy.similarity == SimilarityType::kConsensus
-             ? options.energy.consensus.min_cameras
-             : 1;
+  return NeedsOf(options.energy).cameras_per_gaussian;
 }
 
 int FallbackCamerasWanted(const RefineOptions& options) {
-  return options.energy.similarity == SimilarityType::kConsensus ? CamerasWanted(options) : 0;
+  const SimilarityNeeds needs = NeedsOf(options.energy);
+  return needs.takes_fallback_views ? needs.cameras_per_gaussian : 0;
 }
 
 ReferenceColors ComputeSequenceColors(const SequenceModel& model, const FrameInput& reference,
@@ -208,7 +207,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   // its surface Gaussians carry (for the plain-cloth prior and the sweep's fallback) are this
   // frame's own, taken as the reference frame's are, so no frame depends on another's surface.
   const ReferenceColors frame_colors =
-      options.energy.similarity == SimilarityType::kConsensus
+      NeedsOf(options.energy).colors_of_each_frame
           ? ComputeModelReferenceColors(frame.fine.vertices, frame.normals, input.cameras,
                                         frame.images, visible, options.sigma_hat,
                                         options.energy.overlap, options.energy.reach_sigmas)

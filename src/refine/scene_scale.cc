@@ -5,6 +5,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "finecap/energy/similarity_needs.h"
 #include "finecap/geometry/mesh_edges.h"
 #include "finecap/geometry/subdivision.h"
 #include "finecap/io/capture.h"
@@ -91,9 +92,8 @@ SceneScaleDefaults ResolveSceneScaleDefaults(const Mesh& reference_coarse,
   const SceneLengths& marks = options->scene_lengths;
   defaults.lengths = {
       Choose("RefineOptions::sigma_hat",
-             options->energy.similarity == SimilarityType::kConsensus
-                 ? factors.sigma_hat
-                 : factors.single_gaussian_sigma_hat,
+             NeedsOf(options->energy).compares_patches ? factors.sigma_hat
+                                                       : factors.single_gaussian_sigma_hat,
              s, &options->sigma_hat, marks.sigma_hat),
       Choose("EnergyOptions::k_max", factors.k_max, s, &options->energy.k_max, marks.k_max,
              factors.k_max_of_diagonal * defaults.scale.diagonal),

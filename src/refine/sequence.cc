@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "finecap/energy/similarity_needs.h"
 #include "finecap/measure/metrics.h"
 #include "finecap/solvers/solver_trace.h"
 #include "finecap/util/atomic_file.h"
@@ -73,13 +74,12 @@ void RequireSameRecipe(const ReferenceColors& saved, const SequenceOptions& opti
 // compares colours, since consensus would refine the reference frame for nothing.
 bool TakesColorsAtRefinedSurface(const SequenceOptions& options) {
   return options.colors.reference_surface == ReferenceSurface::kRefined &&
-         options.refine.energy.similarity != SimilarityType::kConsensus;
+         !NeedsOf(options.refine.energy).colors_of_each_frame;
 }
 
 // Whether each frame's colours follow the ones before (pointless under consensus).
 bool FollowsColors(const SequenceOptions& options) {
-  return options.colors.following() &&
-         options.refine.energy.similarity != SimilarityType::kConsensus;
+  return options.colors.following() && !NeedsOf(options.refine.energy).colors_of_each_frame;
 }
 
 // The reference frame's colours, at its coarse or first refined surface.

@@ -25,7 +25,7 @@ struct EnergyProbeSample {
 
 struct EnergyProbe {
   std::string frame;  // The capture's name of the frame.
-  SimilarityType similarity = SimilarityType::kConsensus;
+  SimilarityType similarity = EnergyOptions().similarity;
   OverlapForm overlap = OverlapForm::kExact;
   int num_surface_gaussians = 0;
   long num_pairs = 0;
