@@ -114,10 +114,12 @@ struct EnergyOptions {
   // frame's surface. Read from the saved files of that frame (as refine.warm_start is), so that
   // a resumed run pulls its first frame as an uninterrupted run does; the first frame of a
   // capture, or one whose predecessor is not done (a shard run beside the one before it), is not
-  // pulled. Not in the paper. 0 turns it off. Default 0.3: it lowers both the error and the
-  // flicker of a noisy capture and holds the other synthetic captures within a few tenths of a
-  // point (docs/measurements.md, 2026-12-05).
-  double temporal_weight = 0.3;
+  // pulled. Not in the paper. 0 turns it off. 0.3 lowers both the error and the flicker of a
+  // noisy capture and holds the other synthetic captures within a few tenths of a point
+  // (docs/measurements.md, 2026-12-05). Default 0: with the pull a sequence is one chain, so
+  // shards run side by side (a Slurm array) would no longer equal one process at their first
+  // frames; a single process or shards run in turn get the same result with it.
+  double temporal_weight = 0.0;
   // The consensus similarity's options.
   ConsensusOptions consensus;
   // Colour variation, as a fraction of its median, below which the cloth counts as plain (the
