@@ -33,7 +33,7 @@ function(finecap_add_module name)
     SYMBOLIC)
   file(CREATE_LINK ${PROJECT_SOURCE_DIR}/src/${name} ${internal_root}/${name} SYMBOLIC)
 
-  file(GLOB sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cc)
+  file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cc)
   add_library(finecap_${name} STATIC ${sources})
   target_include_directories(finecap_${name} PUBLIC ${public_root})
   add_library(finecap_${name}_internal INTERFACE)

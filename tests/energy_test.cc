@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include "energy/consensus_similarity.h"
-#include "energy/paper_similarity.h"
-#include "energy/surface_color_similarity.h"
+#include "energy/terms/consensus/consensus_similarity.h"
+#include "energy/terms/paper/paper_similarity.h"
+#include "energy/terms/surface_color/surface_color_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/energy/frame_energy.h"
 #include "model/surface_projection.h"

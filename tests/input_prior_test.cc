@@ -1,4 +1,4 @@
-#include "energy/input_prior.h"
+#include "energy/terms/prior/input_prior.h"
 
 #include <cmath>
 
@@ -124,9 +124,15 @@ TEST(PriorCurvatureTest, AddsTheUniformPullAndTheScaledConfidencePull) {
   options.confidence_prior = 10.0;
   const Eigen::VectorXd data = (Eigen::VectorXd(5) << 4.0, 0.0, 1.0, 3.0, 2.0).finished();
   const Eigen::VectorXd confidence = (Eigen::VectorXd(5) << 0.0, 1.0, 0.5, 1.0, 0.0).finished();
-  const Eigen::VectorXd prior = PriorCurvature(data, confidence, 5, options);
+  int measured = 0;
+  const auto typical = [&] {
+    ++measured;
+    return MedianOfPositive(data);
+  };
+  const Eigen::VectorXd prior = PriorCurvature(typical, confidence, 5, options);
   // Median of the positive data curvatures {1, 2, 3, 4}: the upper middle one, 3; the pull goes
   // with the square of the doubt, 1 - c.
+  EXPECT_EQ(measured, 1);
   const double uniform = 2.0 * 2.0 * 1e6;
   const double doubt_squared[5] = {1.0, 0.0, 0.25, 0.0, 1.0};
   for (int s = 0; s < 5; ++s) {
@@ -134,7 +140,8 @@ TEST(PriorCurvatureTest, AddsTheUniformPullAndTheScaledConfidencePull) {
   }
 
   options.confidence_prior = 0.0;
-  EXPECT_EQ(PriorCurvature({}, {}, 3, options), Eigen::VectorXd::Constant(3, uniform));
+  EXPECT_EQ(PriorCurvature(typical, {}, 3, options), Eigen::VectorXd::Constant(3, uniform));
+  EXPECT_EQ(measured, 1);  // Without a confidence pull the data is not measured.
 }
 
 // On plain cloth the pull is on everywhere: the scalar energy, its gradient and the
@@ -150,16 +157,19 @@ TEST(InputPriorEnergyTest, ScalarGradientAndLeastSquaresFormAgree) {
       scene.surface.input_offset.assign(offsets.data(), offsets.data() + offsets.size());
     }
     FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(50));
-    EXPECT_GT(energy.prior_curvature().minCoeff(), 0.0);
-    EXPECT_EQ(energy.prior_target().norm() > 0.0, off_the_input);
+    EXPECT_GT(energy.pull_curvature().minCoeff(), 0.0);
+    EXPECT_EQ(energy.pull_target().norm() > 0.0, off_the_input);
 
     const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.004, 10);
     Eigen::VectorXd gradient;
-    double similarity = 0.0, regularization = 0.0;
-    const double e = energy.Evaluate(k, &gradient, &similarity, &regularization);
-    const Eigen::VectorXd from_target = k - energy.prior_target();
-    const double prior = 0.5 * from_target.dot(energy.prior_curvature().cwiseProduct(from_target));
-    EXPECT_NEAR(e, similarity - energy.options().w_reg * regularization - prior, 1e-12 * prior);
+    double similarity = 0.0, quadratic = 0.0;
+    const double e = energy.Evaluate(k, &gradient, &similarity, &quadratic);
+    const Eigen::VectorXd from_target = k - energy.pull_target();
+    const double prior = 0.5 * from_target.dot(energy.pull_curvature().cwiseProduct(from_target));
+    const double smoothness = energy.options().w_reg * energy.regularizer().Evaluate(k, nullptr);
+    EXPECT_GT(smoothness, 0.0);
+    EXPECT_NEAR(quadratic, smoothness + prior, 1e-12 * quadratic);
+    EXPECT_NEAR(e, similarity - quadratic, 1e-12 * quadratic);
     EXPECT_NEAR(LeastSquaresCost(&energy, k), -e, 1e-9 * std::abs(e));
 
     const Eigen::VectorXd numeric = NumericGradient(
@@ -168,43 +178,78 @@ TEST(InputPriorEnergyTest, ScalarGradientAndLeastSquaresFormAgree) {
   }
 }
 
-// A second pull (energy.temporal_weight's, towards the frame before) joins the prior as one
-// quadratic per k_s: the energy drops by exactly 1/2 w H (k_s - target_s)^2 over the finite
-// targets, H the median data curvature, for every k; the least-squares form follows it.
-TEST(InputPriorEnergyTest, AddedPullJoinsThePriorAsOneQuadratic) {
+// Pulls on one unknown are one quadratic: the first is taken as it is, a later one adds its
+// curvature and blends the targets by the curvatures; no curvature or no target adds nothing.
+TEST(PullsTest, TwoPullsOnOneUnknownAreOneQuadratic) {
+  Pulls pulls;
+  EXPECT_EQ(pulls.Evaluate(Eigen::VectorXd::Zero(3)), 0.0);
+  pulls.Add(Eigen::Vector3d(2.0, 0.0, 1.0), Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_EQ(pulls.curvature(), Eigen::Vector3d(2.0, 0.0, 1.0));
+  EXPECT_EQ(pulls.target(), Eigen::Vector3d(0.1, 0.0, 0.3));  // No pull, no target.
+  pulls.Add(3.0, Eigen::Vector3d(0.6, 0.4, std::nan("")));
+  EXPECT_EQ(pulls.curvature(), Eigen::Vector3d(5.0, 3.0, 1.0));
+  EXPECT_NEAR(pulls.target()[0], (2.0 * 0.1 + 3.0 * 0.6) / 5.0, 1e-15);
+  EXPECT_EQ(pulls.target()[1], 0.4);
+  EXPECT_EQ(pulls.target()[2], 0.3);
+  // Against the two quadratics summed: equal up to a constant, the same at every k.
+  const auto separate = [](const Eigen::Vector3d& k) {
+    return 0.5 * (2.0 * std::pow(k[0] - 0.1, 2) + 3.0 * std::pow(k[0] - 0.6, 2) +
+                  3.0 * std::pow(k[1] - 0.4, 2) + std::pow(k[2] - 0.3, 2));
+  };
+  const Eigen::Vector3d a(0.0, 0.1, -0.2), b(0.5, -0.3, 0.7);
+  EXPECT_NEAR(separate(a) - pulls.Evaluate(a), separate(b) - pulls.Evaluate(b), 1e-14);
+  pulls.Add(-1.0, Eigen::Vector3d::Zero());  // A negative curvature is no pull.
+  EXPECT_EQ(pulls.curvature(), Eigen::Vector3d(5.0, 3.0, 1.0));
+  EXPECT_THROW(pulls.Add(1.0, Eigen::VectorXd::Zero(4)), Error);
+}
+
+// The temporal pull (energy.temporal_weight) does nothing until the frame before is known, then
+// joins the prior as one quadratic per k_s: the energy drops by exactly 1/2 w H (k_s - before_s)^2
+// over the finite targets, H the median data curvature, for every k; the least-squares form
+// follows it.
+TEST(TemporalTermTest, TheFrameBeforeJoinsThePriorAsOneQuadratic) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 9);
   const Eigen::VectorXd offsets = RandomK(scene.surface.size(), 0.002, 11);
   scene.surface.input_offset.assign(offsets.data(), offsets.data() + offsets.size());
   const FrameEnergy plain(scene.surface, scene.cameras, scene.neighbourhoods,
                           SurfaceColorOptions(50));
-  FrameEnergy pulled(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(50));
-  const int n = pulled.num_parameters();
-  Eigen::VectorXd target = RandomK(n, 0.003, 12);
-  target[1] = std::nan("");  // A vertex the frame before did not refine: not pulled.
+  EnergyOptions options = SurfaceColorOptions(50);
   const double weight = 2.0;
-  pulled.AddPull(target, weight);
+  options.temporal_weight = weight;
+  FrameEnergy pulled(scene.surface, scene.cameras, scene.neighbourhoods, options);
+  const int n = pulled.num_parameters();
+  EXPECT_EQ(pulled.pull_curvature(), plain.pull_curvature());
+  EXPECT_EQ(pulled.pull_target(), plain.pull_target());
+
+  Eigen::VectorXd before = RandomK(n, 0.003, 12);
+  before[1] = std::nan("");  // A vertex the frame before did not refine: not pulled.
+  pulled.TakeFrameBefore(before);
   const double h = MedianOfPositive(DataCurvature(&pulled.similarity(), Eigen::VectorXd::Zero(n)));
   ASSERT_GT(h, 0.0);
-  EXPECT_EQ(pulled.prior_curvature()[1], plain.prior_curvature()[1]);
-  EXPECT_EQ(pulled.prior_target()[1], plain.prior_target()[1]);
-  EXPECT_NEAR(pulled.prior_curvature()[0], plain.prior_curvature()[0] + weight * h,
-              1e-12 * pulled.prior_curvature()[0]);
+  EXPECT_EQ(pulled.pull_curvature()[1], plain.pull_curvature()[1]);
+  EXPECT_EQ(pulled.pull_target()[1], plain.pull_target()[1]);
+  EXPECT_NEAR(pulled.pull_curvature()[0], plain.pull_curvature()[0] + weight * h,
+              1e-12 * pulled.pull_curvature()[0]);
 
   double constant = std::nan("");
   for (unsigned seed : {20u, 21u, 22u}) {
     const Eigen::VectorXd k = RandomK(n, 0.004, seed);
     double pull = 0.0;
     for (int s = 0; s < n; ++s) {
-      if (std::isfinite(target[s])) pull += 0.5 * weight * h * std::pow(k[s] - target[s], 2);
+      if (std::isfinite(before[s])) pull += 0.5 * weight * h * std::pow(k[s] - before[s], 2);
     }
-    const double before = plain.Evaluate(k, nullptr), after = pulled.Evaluate(k, nullptr);
+    const double plain_energy = plain.Evaluate(k, nullptr), energy = pulled.Evaluate(k, nullptr);
     // The blend of two quadratics is one quadratic plus a constant: the same at every k.
-    const double difference = before - after - pull;
+    const double difference = plain_energy - energy - pull;
     if (std::isnan(constant)) constant = difference;
-    EXPECT_NEAR(difference, constant, 1e-9 * std::abs(after));
-    EXPECT_NEAR(LeastSquaresCost(&pulled, k), -after, 1e-9 * std::abs(after));
+    EXPECT_NEAR(difference, constant, 1e-9 * std::abs(energy));
+    EXPECT_NEAR(LeastSquaresCost(&pulled, k), -energy, 1e-9 * std::abs(energy));
   }
-  EXPECT_THROW(pulled.AddPull(Eigen::VectorXd::Zero(n + 1), 1.0), Error);
+  // Taken again, the frame before replaces itself rather than pulling twice.
+  const Eigen::VectorXd curvature = pulled.pull_curvature();
+  pulled.TakeFrameBefore(before);
+  EXPECT_EQ(pulled.pull_curvature(), curvature);
+  EXPECT_THROW(pulled.TakeFrameBefore(Eigen::VectorXd::Zero(n + 1)), Error);
 }
 
 }  // namespace

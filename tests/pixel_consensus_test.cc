@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "energy/pixel_consensus_similarity.h"
+#include "energy/terms/consensus/pixel_consensus_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/energy/frame_energy.h"
 #include "finecap/util/error.h"

@@ -10,7 +10,7 @@
 #include <ceres/problem.h>
 #include <gtest/gtest.h>
 
-#include "energy/consensus_similarity.h"
+#include "energy/terms/consensus/consensus_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/util/error.h"
 #include "solvers/ceres_cost_functions.h"
@@ -297,7 +297,7 @@ TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
     int with_row = 0, with_prior = 0;
     for (const SimilarityTerm::ResidualBlock& block : energy.similarity().residual_blocks()) {
       ++with_row;
-      with_prior += energy.prior_curvature()[block.parameters[0]] > 0.0;
+      with_prior += energy.pull_curvature()[block.parameters[0]] > 0.0;
     }
     EXPECT_EQ(merged_residuals, separate_residuals - with_row - with_prior + 1);
   }
@@ -452,7 +452,7 @@ TEST(SolverTest, CeresProblemHasTheLeastSquaresCost) {
     scene.surface.input_offset.push_back(0.001 * std::cos(0.7 * s));
   }
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, energy_options);
-  ASSERT_GT(energy.prior_curvature().maxCoeff(), 0.0);
+  ASSERT_GT(energy.pull_curvature().maxCoeff(), 0.0);
   ASSERT_FALSE(energy.regularizer().pairs().empty());
   SolverOptions options;
   options.max_iterations = 3;

@@ -55,10 +55,10 @@ int RunProbe(const Config& configured, int frame_index) {
       probe.frame.c_str(), EnumToString(probe.similarity).c_str(),
       EnumToString(probe.overlap).c_str(), probe.num_surface_gaussians, probe.num_pairs,
       1000.0 * probe.rms_truth);
-  std::printf("%8s %16s %16s %16s\n", "alpha", "E", "E_sim", "E_reg");
+  std::printf("%8s %16s %16s %16s\n", "alpha", "E", "E_sim", "E_quad");
   for (const EnergyProbeSample& sample : probe.samples) {
     std::printf("%8.2f %16.8g %16.8g %16.8g\n", sample.alpha, sample.energy, sample.similarity,
-                sample.regularization);
+                sample.quadratic);
   }
   const std::string plot_path = out + "/probe_" + probe.frame + ".png";
   WriteEnergyProbePlot(probe, plot_path);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "finecap/measure/metrics.h"
+#include "finecap/solvers/solver.h"
 #include "finecap/util/error.h"
 
 namespace finecap {
@@ -110,9 +111,19 @@ VariantSummary SummarizeVariant(const std::string& name, const std::vector<Frame
   return row;
 }
 
+namespace {
+
+// Whether the row's solver is the paper's: the reference of a comparison unless one is named.
+bool SolvesAsThePaper(const VariantSummary& row) {
+  SolverType type = SolverType::kCeres;  // Names the enum; StringToEnum sets it.
+  return StringToEnum(row.solver, &type) && type == SolverType::kGradientAscent;
+}
+
+}  // namespace
+
 int ReferenceVariant(const std::vector<VariantSummary>& rows, const std::string& reference) {
   for (size_t i = 0; i < rows.size(); ++i) {
-    if (reference.empty() ? rows[i].solver == "gradient_ascent" : rows[i].name == reference) {
+    if (reference.empty() ? SolvesAsThePaper(rows[i]) : rows[i].name == reference) {
       return static_cast<int>(i);
     }
   }

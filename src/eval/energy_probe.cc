@@ -80,7 +80,7 @@ EnergyProbe ProbeEnergyAlongTruth(Capture* capture, int frame, const SequenceMod
     EnergyProbeSample sample;
     sample.alpha = 0.1 * step;
     sample.energy =
-        energy.Evaluate(sample.alpha * truth, nullptr, &sample.similarity, &sample.regularization);
+        energy.Evaluate(sample.alpha * truth, nullptr, &sample.similarity, &sample.quadratic);
     probe.samples.push_back(sample);
   }
   probe.similarity_optimum = Optimum(probe.samples, &EnergyProbeSample::similarity);

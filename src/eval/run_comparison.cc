@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "finecap/energy/similarity_needs.h"
 #include "finecap/eval/html_report.h"
 #include "finecap/refine/frame_reader.h"
 #include "finecap/refine/run_folder.h"
@@ -21,7 +22,7 @@ double PaperSimilarityAtResult(const SequenceModel& model, const ReferenceColors
                                const FrameInput& input, const RefineOptions& refine,
                                const FrameStats& stats, const Eigen::VectorXd& k_fine) {
   RefineOptions options = refine;
-  options.energy.similarity = SimilarityType::kPaper;
+  options.energy = WithThePapersSimilarity(options.energy);
   const PreparedFrame frame = PrepareFrame(model, colors, input, options);
   const std::vector<int>& ids = frame.energy->surface().vertex_ids;
   const Eigen::VectorXd solved = SolvedDisplacement(k_fine, stats.kept_input, options);

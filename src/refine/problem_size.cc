@@ -41,7 +41,7 @@ constexpr double kBytesPerUndistortedPixel = 6.0;
 // counted exactly (24 B per node).
 constexpr double kBytesPerConsensusPair = 6.0;
 constexpr double kBytesPerPair = 7.4;
-constexpr double kConsensusBytesPerObservation = 40.0;
+constexpr double kTabledBytesPerObservation = 40.0;
 // Residual blocks, neighbourhoods, the regulariser, the sweep's costs and the solver's sparse
 // matrices, which grow with the surface Gaussians (not with the cameras that see them): with
 // conjugate gradients (Ceres' CGNR, the default), and what the sparse Cholesky factorisation's
@@ -155,7 +155,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
                                                  : kBytesPerPair);
   if (const int nodes = ColorTableNodes(options.energy, options.sigma_hat); nodes > 0) {
     // Its colour tables: value and derivative, 3 floats each, per node.
-    per_frame += size.num_observations * (nodes * 24.0 + kConsensusBytesPerObservation);
+    per_frame += size.num_observations * (nodes * 24.0 + kTabledBytesPerObservation);
   }
   double detail_bytes = 0.0, detail_seconds = 0.0;
   if (sampled) {

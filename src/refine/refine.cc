@@ -329,15 +329,14 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
   return summary;
 }
 
-// Pulls `energy`'s k towards the frame before's (FrameInput::frame_before_k) with
-// energy.temporal_weight, when both are there.
-void PullTowardsTheFrameBefore(const FrameInput& input, const RefineOptions& options,
-                               FrameEnergy* energy) {
-  if (options.energy.temporal_weight <= 0.0 || input.frame_before_k.size() == 0) return;
+// Hands the frame before's solution (FrameInput::frame_before_k), when there is one, to the terms
+// of `energy` that read it.
+void TakeTheFrameBefore(const FrameInput& input, FrameEnergy* energy) {
+  if (input.frame_before_k.size() == 0) return;
   const std::vector<int>& ids = energy->surface().vertex_ids;
-  Eigen::VectorXd target(static_cast<Eigen::Index>(ids.size()));
-  for (size_t s = 0; s < ids.size(); ++s) target[s] = input.frame_before_k[ids[s]];
-  energy->AddPull(target, options.energy.temporal_weight);
+  Eigen::VectorXd k_before(static_cast<Eigen::Index>(ids.size()));
+  for (size_t s = 0; s < ids.size(); ++s) k_before[s] = input.frame_before_k[ids[s]];
+  energy->TakeFrameBefore(k_before);
 }
 
 // Where the solve of a prepared frame starts: one k per surface Gaussian of its energy.
@@ -372,7 +371,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
                                        FrameImageModels(input, level_options.image));
     *seconds_preparation += frame.seconds;
     if (k.size() == 0) k = starting_point(&frame);
-    PullTowardsTheFrameBefore(input, level_options, frame.energy.get());
+    TakeTheFrameBefore(input, frame.energy.get());
     const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
     totals->AddWork(summary);
   }
@@ -406,7 +405,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   // The frame got worse or better against where it started, before any level moved it.
   const Eigen::VectorXd initial = starting_point(&frame);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
-  PullTowardsTheFrameBefore(input, options, frame.energy.get());
+  TakeTheFrameBefore(input, frame.energy.get());
   result.summary = SolveFrameEnergy(frame.energy.get(), options, &k, workspace);
   if (coarse_k.size() > 0) {
     EvaluateEnergyAndCost(frame.energy.get(), initial, &result.summary.energy_start,
@@ -421,7 +420,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     PrepareDetailEnergy(model, input, options, &frame);
     result.seconds_preparation += frame.seconds - seconds;
     ShapePatchesLike(k, options, frame.energy.get());
-    PullTowardsTheFrameBefore(input, options, frame.energy.get());
+    TakeTheFrameBefore(input, frame.energy.get());
     SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
     EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,
                           &summary.ls_cost_start);

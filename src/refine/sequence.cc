@@ -441,7 +441,7 @@ class SequenceRun {
     const std::vector<CalibratedImage>& held_out = read.held_out;
     const std::vector<SkippedCamera>& skipped = read.skipped;
     ReadAheadAfter(frame, frames);
-    const bool pulled = options_.refine.energy.temporal_weight > 0.0;
+    const bool pulled = NeedsOf(options_.refine.energy).reads_frame_before;
     const Eigen::VectorXd before = options_.refine.warm_start || pulled
                                        ? SolvedFrameBefore(out_, *capture_, frame, options_, model_)
                                        : Eigen::VectorXd();

@@ -327,29 +327,25 @@ struct SmoothnessRows {
   }
 };
 
-// Each pair of neighbours goes to its first Gaussian, `pair.a`.
+// Each difference of neighbours goes to its first Gaussian, `a`.
 SmoothnessRows SmoothnessRowsOfEachGaussian(const FrameEnergy& energy, int num_gaussians) {
-  const Regularizer& regularizer = energy.regularizer();
-  const Eigen::VectorXd& prior = energy.prior_curvature();
-  const double w_reg = energy.options().w_reg;
+  const Eigen::VectorXd& prior = energy.pull_curvature();
   SmoothnessRows rows;
   rows.prior_root.resize(num_gaussians);
   for (int s = 0; s < num_gaussians; ++s) {
     rows.prior_root[s] = prior[s] > 0.0 ? std::sqrt(prior[s]) : 0.0;
   }
   rows.begin.assign(num_gaussians + 1, 0);
-  const std::vector<Regularizer::Pair> none;
-  const std::vector<Regularizer::Pair>& pairs = w_reg == 0.0 ? none : regularizer.pairs();
-  for (const Regularizer::Pair& pair : pairs) ++rows.begin[pair.a + 1];
+  const std::vector<Difference>& pairs = energy.differences();
+  for (const Difference& pair : pairs) ++rows.begin[pair.a + 1];
   std::partial_sum(rows.begin.begin(), rows.begin.end(), rows.begin.begin());
   rows.neighbours.resize(pairs.size());
   rows.other.resize(pairs.size());
   std::vector<int> next(rows.begin.begin(), rows.begin.end() - 1);
   std::vector<int> num_free(num_gaussians, 0);
-  for (const Regularizer::Pair& pair : pairs) {
+  for (const Difference& pair : pairs) {
     const int j = next[pair.a]++;
-    rows.neighbours[j].coefficient =
-        2.0 * std::sqrt(w_reg * pair.weight) * regularizer.unit_scale();
+    rows.neighbours[j].coefficient = pair.root;
     rows.neighbours[j].parameter = pair.b >= 0 ? ++num_free[pair.a] : -1;
     rows.other[j] = pair.b;
   }
@@ -377,8 +373,8 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
   neighbour_begin_ = rows.begin;
   neighbour_other_ = rows.other;
   model_rows_ = std::make_unique<GaussianModelRows>(energy.similarity(), secant);
-  const Eigen::VectorXd& prior = energy.prior_curvature();
-  const Eigen::VectorXd& target = energy.prior_target();
+  const Eigen::VectorXd& prior = energy.pull_curvature();
+  const Eigen::VectorXd& target = energy.pull_target();
   std::vector<double*> parameter_blocks;
   for (int s = 0; s < num_gaussians; ++s) {
     if (!per_gaussian && rows.empty(s)) continue;
@@ -424,8 +420,8 @@ bool FrameCostFunctions::Rebind(const FrameEnergy& energy) {
   // In place: every SurfaceGaussianCost holds its neighbours' address.
   std::copy(rows.neighbours.begin(), rows.neighbours.end(), neighbours_.begin());
   model_rows_->Rebind(term);
-  const Eigen::VectorXd& prior = energy.prior_curvature();
-  const Eigen::VectorXd& target = energy.prior_target();
+  const Eigen::VectorXd& prior = energy.pull_curvature();
+  const Eigen::VectorXd& target = energy.pull_target();
   for (int s = 0; s < num_gaussians; ++s) {
     model_rows_->Set(s, block_of[s], std::max(0.0, prior[s]), target[s]);
   }

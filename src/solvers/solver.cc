@@ -16,12 +16,9 @@ double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
   energy->similarity().BlockCosts(k, &block_costs);
   double sum_of_squares = 0.0;
   for (double cost : block_costs) sum_of_squares += cost;
-  // The regulariser's residuals are 2 sqrt(w T) u (k_a - k_b): their half sum of squares is
-  // w_reg * E_reg; the prior's, sqrt(p_s) (k_s - t_s), give E_prior.
-  const Eigen::VectorXd from_target = k - energy->prior_target();
-  return 0.5 * sum_of_squares +
-         energy->options().w_reg * energy->regularizer().Evaluate(k, nullptr) +
-         0.5 * from_target.dot(energy->prior_curvature().cwiseProduct(from_target));
+  // The differences' residuals root (k_a - k_b) and the pulls', sqrt(p_s) (k_s - t_s): their
+  // half sums of squares are the parts of E_quad.
+  return 0.5 * sum_of_squares + energy->DifferenceEnergy(k, nullptr) + energy->PullEnergy(k);
 }
 
 void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double* energy_value,

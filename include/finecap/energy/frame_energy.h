@@ -1,8 +1,10 @@
-// The energy of one frame, E(k) = E_sim(k) - w_reg * E_reg(k) (the paper's eq. 3) - E_prior(k)
-// (input_prior.h; zero unless configured), built from the
-// surface Gaussians, the cameras with their image Gaussians and visibility, and the mesh's
-// neighbourhoods. It owns the pair lists, so it is built once per frame and then evaluated many
-// times by a solver; it is neither copied nor moved (the terms refer to its members).
+// The energy of one frame, E(k) = E_sim(k) - E_quad(k): the similarity and the terms quadratic in
+// k (quadratic_term.h: the paper's w_reg * E_reg, eq. 3, and the pulls that are not in the paper,
+// towards the input and towards the frame before), built from the surface Gaussians, the cameras
+// with their image Gaussians and visibility, and the mesh's neighbourhoods. Which terms it holds
+// follows from the options alone (src/energy/term_registry.cc). It owns the pair lists, so it is
+// built once per frame and then evaluated many times by a solver; it is neither copied nor moved
+// (the terms refer to its members).
 #ifndef FINECAP_FRAME_ENERGY_H_
 #define FINECAP_FRAME_ENERGY_H_
 
@@ -14,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/energy/energy_options.h"
+#include "finecap/energy/quadratic_term.h"
 #include "finecap/energy/regularizer.h"
 #include "finecap/energy/similarity.h"
 #include "finecap/geometry/neighbourhood.h"
@@ -78,26 +81,34 @@ class FrameEnergy {
   SimilarityTerm& similarity() { return *similarity_; }
   const SimilarityTerm& similarity() const { return *similarity_; }
   const Regularizer& regularizer() const { return regularizer_; }
-  // p_s and t_s of E_prior = 1/2 sum_s p_s (k_s - t_s)^2 (input_prior.h), one entry per surface
-  // Gaussian: t_s is where the input as given lies (SurfaceGaussians::input_offset; 0 without).
-  const Eigen::VectorXd& prior_curvature() const { return prior_curvature_; }
-  const Eigen::VectorXd& prior_target() const { return prior_target_; }
+  // The quadratic part, as its terms made it: the pulls on each k_s, gathered into one p_s and
+  // t_s per surface Gaussian, and the differences of neighbours.
+  const Eigen::VectorXd& pull_curvature() const { return pulls_.curvature(); }
+  const Eigen::VectorXd& pull_target() const { return pulls_.target(); }
+  const std::vector<Difference>& differences() const { return differences_; }
+  // The differences' part of E_quad at k, 1/2 sum root^2 (k_a - k_b)^2, and, unless `gradient` is
+  // null, its gradient; and the pulls' part.
+  double DifferenceEnergy(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const;
+  double PullEnergy(const Eigen::VectorXd& k) const { return pulls_.Evaluate(k); }
   // c_s, how sure the images are of each k_s (Confidence, input_prior.h); the confidence pull
   // (energy.confidence_prior) holds k_s at the input where it is low.
   const Eigen::VectorXd& confidence() const { return confidence_; }
-  // Adds 1/2 (weight H) (k_s - target_s)^2 to E_prior for every s whose target_s is finite, with
-  // H the median of the positive data curvatures at the input, so that `weight` is in the data's
-  // own units as energy.confidence_prior is. Two pulls on one k_s are one: their curvatures add
-  // and their targets blend by them, so the solvers see the same quadratic prior as before.
-  void AddPull(const Eigen::VectorXd& target, double weight);
+  // Hands the displacement the frame before was solved with (one per surface Gaussian, NaN where
+  // it has none) to the terms that read it (the temporal pull), once it is known.
+  void TakeFrameBefore(const Eigen::VectorXd& k_before);
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 
-  // E at k and, when `gradient` is not null, dE/dk. The parts go to the optional outputs.
+  // E at k and, when `gradient` is not null, dE/dk. E_sim and E_quad go to the optional outputs.
   double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient, double* similarity = nullptr,
-                  double* regularization = nullptr) const;
+                  double* quadratic = nullptr) const;
 
  private:
+  // H of TermContext::typical_data_curvature, measured at first use; below 0 until then.
+  double TypicalDataCurvature();
+  // The pulls of every quadratic term, gathered anew.
+  void GatherPulls();
+
   SurfaceGaussians surface_;
   EnergyOptions options_;
   // With samples, what the similarity reads: the samples and the cameras' pixels.
@@ -106,10 +117,11 @@ class FrameEnergy {
   std::vector<EnergyView> views_;
   std::unique_ptr<SimilarityTerm> similarity_;
   Regularizer regularizer_;
-  Eigen::VectorXd prior_curvature_;
-  Eigen::VectorXd prior_target_;
   Eigen::VectorXd confidence_;
-  double typical_data_curvature_ = -1.0;  // H of AddPull; below 0 until measured.
+  std::vector<std::unique_ptr<QuadraticTerm>> quadratic_terms_;
+  Pulls pulls_;
+  std::vector<Difference> differences_;
+  double typical_data_curvature_ = -1.0;  // Below 0 until measured.
   long num_pairs_ = 0;
 };
 

@@ -2,10 +2,10 @@
 //  * a scalar to maximise, with its gradient (the paper's gradient ascent, L-BFGS);
 //  * residual blocks of a least-squares problem, each depending on a few k_s, with Jacobians
 //    (Ceres), such that a smaller sum of squares means a higher similarity.
-// Implementations: PaperSimilarity (paper_similarity.h), SurfaceColorSimilarity
-// (surface_color_similarity.h), ConsensusSimilarity (consensus_similarity.h) and
-// PixelConsensusSimilarity (pixel_consensus_similarity.h), the last two on PatchAgreementTerm
-// (patch_agreement.h).
+// Implementations, each in its folder of src/energy/terms/ and built by the registry
+// (src/energy/term_registry.cc): PaperSimilarity (paper/), SurfaceColorSimilarity
+// (surface_color/), ConsensusSimilarity and PixelConsensusSimilarity (consensus/, both on
+// PatchAgreementTerm, patch_agreement.h).
 #ifndef FINECAP_SIMILARITY_H_
 #define FINECAP_SIMILARITY_H_
 

@@ -1,7 +1,7 @@
-// What the rest of finecap must know of the configured similarity: how many cameras it compares,
-// whose colours its surface Gaussians carry, what it reads and what its tables hold. The one
-// place that maps each SimilarityType to those needs, so that no code outside the energy tests a
-// similarity's kind: a new similarity states its needs here and nowhere else.
+// What the rest of finecap must know of the configured energy: how many cameras its similarity
+// compares, whose colours its surface Gaussians carry, what its terms read and what its tables
+// hold. The answers come from the registry of the energy's terms (src/energy/term_registry.cc),
+// so that no code outside it tests a similarity's kind: a new term states its needs there.
 #ifndef FINECAP_ENERGY_SIMILARITY_NEEDS_H_
 #define FINECAP_ENERGY_SIMILARITY_NEEDS_H_
 
@@ -28,10 +28,19 @@ struct SimilarityNeeds {
   // Whether it reads the images at surface samples about a pixel apart after the image models'
   // stage (ConsensusOptions::sample_spacing above 0).
   bool reads_surface_samples = false;
+  // Whether a term reads the displacement the frame before was solved with
+  // (FrameEnergy::TakeFrameBefore): the temporal pull. A sequence then reads it from that frame's
+  // saved files, as it does for a warm start.
+  bool reads_frame_before = false;
 };
 
 // The needs of options.similarity under `options`.
 SimilarityNeeds NeedsOf(const EnergyOptions& options);
+
+// `options` with the paper's similarity as printed (eq. 6) in place of the configured one, every
+// other setting kept: the one energy by which runs of different settings can be compared
+// (run_comparison.h).
+EnergyOptions WithThePapersSimilarity(EnergyOptions options);
 
 // Nodes of each colour table the similarity keeps per observation (a surface Gaussian seen by a
 // camera) for Gaussians of `sigma_hat` over [-k_max, k_max]; 0 for a similarity without tables.

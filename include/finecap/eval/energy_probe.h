@@ -15,12 +15,12 @@
 
 namespace finecap {
 
-// The energy and its two parts at one alpha.
+// The energy and its two parts at one alpha, E = E_sim - E_quad (frame_energy.h).
 struct EnergyProbeSample {
   double alpha = 0.0;
   double energy = 0.0;
   double similarity = 0.0;
-  double regularization = 0.0;
+  double quadratic = 0.0;  // The terms quadratic in k: smoothness (w_reg E_reg) and pulls.
 };
 
 struct EnergyProbe {

@@ -150,8 +150,8 @@ struct FrameInput {
   std::vector<ImageGaussians> image_models;
   ImageGaussianOptions image_model_options;
   // The solved displacement of the frame before, one per fine vertex (NaN where not refined),
-  // that energy.temporal_weight pulls this frame's k towards; empty: no pull. Set only once that
-  // frame is solved, so it is never part of what is read or prepared ahead.
+  // for the energy's terms that read it (SimilarityNeeds::reads_frame_before); empty: none. Set
+  // only once that frame is solved, so it is never part of what is read or prepared ahead.
   Eigen::VectorXd frame_before_k;
 };
 

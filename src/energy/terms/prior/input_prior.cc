@@ -1,4 +1,4 @@
-#include "energy/input_prior.h"
+#include "energy/terms/prior/input_prior.h"
 
 #include <algorithm>
 #include <cmath>
@@ -129,18 +129,29 @@ Eigen::VectorXd Confidence(const SurfaceGaussians& surface, const Eigen::VectorX
   return confidence;
 }
 
-Eigen::VectorXd PriorCurvature(const Eigen::VectorXd& data_curvature,
+Eigen::VectorXd PriorCurvature(const std::function<double()>& typical_data_curvature,
                                const Eigen::VectorXd& confidence, int num_parameters,
                                const EnergyOptions& options) {
   const double u = options.RegUnitScale();
   Eigen::VectorXd prior = Eigen::VectorXd::Constant(num_parameters, 2.0 * options.w_prior * u * u);
   if (options.confidence_prior <= 0.0) return prior;
-  const double typical = MedianOfPositive(data_curvature);
+  const double typical = typical_data_curvature();
   if (typical <= 0.0) return prior;
   // Squared, so that a Gaussian the images nearly decide is hardly held: (1 - c)^2 is 0.01 at
   // c = 0.9, where a linear pull, 0.1, took detail that steep but sound views had found.
   prior += options.confidence_prior * typical * (1.0 - confidence.array()).square().matrix();
   return prior;
 }
+
+InputPriorTerm::InputPriorTerm(const TermContext& context)
+    : curvature_(PriorCurvature(context.typical_data_curvature, context.confidence,
+                                context.surface.size(), context.options)),
+      target_(context.surface.input_offset.empty()
+                  ? Eigen::VectorXd::Zero(context.surface.size())
+                  : Eigen::Map<const Eigen::VectorXd>(context.surface.input_offset.data(),
+                                                      context.surface.size())
+                        .eval()) {}
+
+void InputPriorTerm::AddPulls(Pulls* pulls) const { pulls->Add(curvature_, target_); }
 
 }  // namespace finecap

@@ -28,7 +28,7 @@
 
 #include <Eigen/Core>
 
-#include "energy/patch_agreement.h"
+#include "energy/terms/consensus/patch_agreement.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/frame_energy.h"
 

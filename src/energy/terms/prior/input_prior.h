@@ -12,12 +12,15 @@
 // (energy.confidence_prior) holds each Gaussian by how little the images decide it (Confidence: the
 // views that see it, the texture around it), with a strength in the units of the data's own
 // curvature.
-#ifndef FINECAP_INPUT_PRIOR_H_
-#define FINECAP_INPUT_PRIOR_H_
+#ifndef FINECAP_ENERGY_TERMS_PRIOR_INPUT_PRIOR_H_
+#define FINECAP_ENERGY_TERMS_PRIOR_INPUT_PRIOR_H_
+
+#include <functional>
 
 #include <Eigen/Core>
 
 #include "finecap/energy/energy_options.h"
+#include "finecap/energy/quadratic_term.h"
 #include "finecap/energy/regularizer.h"
 #include "finecap/energy/similarity.h"
 #include "finecap/model/surface_gaussians.h"
@@ -57,12 +60,25 @@ Eigen::VectorXd PlainCloth(const SurfaceGaussians& surface, const Regularizer& r
 Eigen::VectorXd Confidence(const SurfaceGaussians& surface, const Eigen::VectorXd& plain_cloth);
 
 // p_s = 2 w_prior u^2 + mu H (1 - c_s)^2: the uniform pull and the confidence pull, with u the
-// unit scale of E_reg, mu = confidence_prior, H the median of the positive data curvatures (it
-// gives the pull the data's units) and c_s = `confidence`. Both vectors may be empty when mu is 0.
-Eigen::VectorXd PriorCurvature(const Eigen::VectorXd& data_curvature,
+// unit scale of E_reg, mu = confidence_prior, H = `typical_data_curvature` (the median of the
+// positive data curvatures: it gives the pull the data's units; called only when mu > 0) and
+// c_s = `confidence` (may be empty when mu is 0).
+Eigen::VectorXd PriorCurvature(const std::function<double()>& typical_data_curvature,
                                const Eigen::VectorXd& confidence, int num_parameters,
                                const EnergyOptions& options);
 
+// E_prior as a quadratic term of the energy (quadratic_term.h): the pulls p_s of PriorCurvature
+// towards t_s, where the input as given lies (SurfaceGaussians::input_offset; 0 without).
+class InputPriorTerm : public QuadraticTerm {
+ public:
+  explicit InputPriorTerm(const TermContext& context);
+  void AddPulls(Pulls* pulls) const override;
+
+ private:
+  Eigen::VectorXd curvature_;
+  Eigen::VectorXd target_;
+};
+
 }  // namespace finecap
 
-#endif  // FINECAP_INPUT_PRIOR_H_
+#endif  // FINECAP_ENERGY_TERMS_PRIOR_INPUT_PRIOR_H_

@@ -1,4 +1,4 @@
-#include "energy/pixel_consensus_similarity.h"
+#include "energy/terms/consensus/pixel_consensus_similarity.h"
 
 #include <algorithm>
 #include <cmath>

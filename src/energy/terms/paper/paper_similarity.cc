@@ -1,4 +1,4 @@
-#include "energy/paper_similarity.h"
+#include "energy/terms/paper/paper_similarity.h"
 
 #include <cmath>
 

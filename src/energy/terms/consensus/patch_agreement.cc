@@ -1,4 +1,4 @@
-#include "energy/patch_agreement.h"
+#include "energy/terms/consensus/patch_agreement.h"
 
 #include <algorithm>
 #include <cmath>

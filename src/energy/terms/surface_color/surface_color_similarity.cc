@@ -1,4 +1,4 @@
-#include "energy/surface_color_similarity.h"
+#include "energy/terms/surface_color/surface_color_similarity.h"
 
 #include <cmath>
 

@@ -48,7 +48,7 @@
 
 #include <vector>
 
-#include "energy/patch_agreement.h"
+#include "energy/terms/consensus/patch_agreement.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/similarity.h"
 #include "finecap/model/gaussian_overlap.h"

@@ -1,11 +1,11 @@
-#include "energy/consensus_similarity.h"
+#include "energy/terms/consensus/consensus_similarity.h"
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
-#include "energy/patch_agreement.h"
-#include "energy/surface_color_similarity.h"
+#include "energy/terms/consensus/patch_agreement.h"
+#include "energy/terms/surface_color/surface_color_similarity.h"
 #include "finecap/util/error.h"
 #include "model/image_color.h"
 #include "model/surface_projection.h"

@@ -1,0 +1,96 @@
+#include "energy/term_registry.h"
+
+#include "energy/terms/consensus/consensus_similarity.h"
+#include "energy/terms/consensus/pixel_consensus_similarity.h"
+#include "energy/terms/paper/paper_similarity.h"
+#include "energy/terms/prior/input_prior.h"
+#include "energy/terms/smoothness/smoothness_term.h"
+#include "energy/terms/surface_color/surface_color_similarity.h"
+#include "energy/terms/temporal/temporal_term.h"
+#include "finecap/energy/similarity_needs.h"
+#include "finecap/util/error.h"
+
+namespace finecap {
+namespace internal {
+namespace {
+
+// For each surface Gaussian, the surface Gaussians at most `rings` edges away on the mesh (at most
+// as far as the neighbourhoods reach).
+std::vector<std::vector<int>> SurfaceRings(const SurfaceGaussians& surface,
+                                           const VertexNeighbourhoods& neighbourhoods, int rings) {
+  std::vector<int> surface_of_vertex(neighbourhoods.num_vertices(), -1);
+  for (int s = 0; s < surface.size(); ++s) surface_of_vertex[surface.vertex_ids[s]] = s;
+  std::vector<std::vector<int>> patches(surface.size());
+  for (int s = 0; s < surface.size(); ++s) {
+    const int v = surface.vertex_ids[s];
+    for (int e = neighbourhoods.offsets[v]; e < neighbourhoods.offsets[v + 1]; ++e) {
+      const int j = surface_of_vertex[neighbourhoods.neighbours[e]];
+      if (neighbourhoods.edge_distances[e] <= rings && j >= 0) patches[s].push_back(j);
+    }
+  }
+  return patches;
+}
+
+}  // namespace
+
+std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
+                                               const std::vector<EnergyView>& views,
+                                               const VertexNeighbourhoods& neighbourhoods,
+                                               const SurfaceSamples& samples,
+                                               const std::vector<CameraInput>& sample_cameras,
+                                               const EnergyOptions& options) {
+  const OverlapForm form = options.overlap;
+  if (samples.size() > 0) {
+    Require(options.similarity == SimilarityType::kConsensus, "energy.similarity",
+            "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
+    return std::make_unique<PixelConsensusSimilarity>(samples, sample_cameras, options.consensus);
+  }
+  if (options.similarity == SimilarityType::kPaper)
+    return std::make_unique<PaperSimilarity>(surface, views, form);
+  if (options.similarity == SimilarityType::kConsensus) {
+    return std::make_unique<ConsensusSimilarity>(
+        surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form,
+        options.k_max, options.reach_sigmas, options.consensus);
+  }
+  return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
+}
+
+std::vector<std::unique_ptr<QuadraticTerm>> MakeQuadraticTerms(const TermContext& context) {
+  std::vector<std::unique_ptr<QuadraticTerm>> terms;
+  terms.push_back(std::make_unique<SmoothnessTerm>(context));
+  terms.push_back(std::make_unique<InputPriorTerm>(context));
+  if (context.options.temporal_weight > 0.0) {
+    terms.push_back(std::make_unique<TemporalTerm>(context));
+  }
+  return terms;
+}
+
+bool WeighsPairsByColor(const EnergyOptions& options) {
+  return options.similarity == SimilarityType::kPaper;
+}
+
+}  // namespace internal
+
+SimilarityNeeds NeedsOf(const EnergyOptions& options) {
+  SimilarityNeeds needs;
+  needs.reads_frame_before = options.temporal_weight > 0.0;
+  if (options.similarity != SimilarityType::kConsensus) return needs;
+  needs.cameras_per_gaussian = options.consensus.min_cameras;
+  needs.takes_fallback_views = true;
+  needs.colors_of_each_frame = true;
+  needs.compares_patches = true;
+  needs.reads_surface_samples = options.consensus.sample_spacing > 0.0;
+  return needs;
+}
+
+EnergyOptions WithThePapersSimilarity(EnergyOptions options) {
+  options.similarity = SimilarityType::kPaper;
+  return options;
+}
+
+int ColorTableNodes(const EnergyOptions& options, double sigma_hat) {
+  if (options.similarity != SimilarityType::kConsensus) return 0;
+  return ConsensusSimilarity::NumTableNodes(sigma_hat, options.k_max);
+}
+
+}  // namespace finecap
