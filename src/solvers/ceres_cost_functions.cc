@@ -356,7 +356,7 @@ SmoothnessRows SmoothnessRowsOfEachGaussian(const FrameEnergy& energy, int num_g
 
 void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout,
                                            Eigen::VectorXd* k, ceres::Problem* problem) {
-  const double k_max = energy.options().k_max;
+  const double k_max = energy.layout().bound;
   const int num_gaussians = static_cast<int>(k->size());
   for (int s = 0; s < num_gaussians; ++s) {
     problem->AddParameterBlock(&(*k)[s], 1);
@@ -405,8 +405,7 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
 bool FrameCostFunctions::Rebind(const FrameEnergy& energy) {
   const SimilarityTerm& term = energy.similarity();
   const int num_gaussians = model_rows_ != nullptr ? model_rows_->size() : 0;
-  if (!rebindable_ || energy.num_parameters() != num_gaussians ||
-      energy.options().k_max != k_max_) {
+  if (!rebindable_ || energy.num_parameters() != num_gaussians || energy.layout().bound != k_max_) {
     return false;
   }
   std::vector<int> block_of(num_gaussians, -1);

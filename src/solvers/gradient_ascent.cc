@@ -9,7 +9,7 @@ namespace internal {
 void SolveWithGradientAscent(const FrameEnergy& energy, const SolverOptions& options,
                              Eigen::VectorXd* k, SolverSummary* summary) {
   const Stopwatch clock;
-  const double k_max = energy.options().k_max;
+  const double k_max = energy.layout().bound;
   const int n = static_cast<int>(k->size());
   Eigen::VectorXd gradient, previous_gradient = Eigen::VectorXd::Zero(n);
   // The conditioner: one step factor per k_s, scaled at the first iteration so that the largest

@@ -14,7 +14,7 @@ namespace {
 class NegativeEnergy : public ceres::FirstOrderFunction {
  public:
   NegativeEnergy(const FrameEnergy& energy, int* evaluations)
-      : energy_(energy), k_max_(energy.options().k_max), evaluations_(evaluations) {}
+      : energy_(energy), k_max_(energy.layout().bound), evaluations_(evaluations) {}
 
   int NumParameters() const override { return energy_.num_parameters(); }
 

@@ -73,7 +73,7 @@ void FrameSolver::SolveWithCeres(Eigen::VectorXd* k, SolverSummary* summary) {
 
 SolverSummary FrameSolver::Solve(Eigen::VectorXd* k) {
   Require(k->size() == energy_->num_parameters(), "solver", "k has the wrong size");
-  const double k_max = energy_->options().k_max;
+  const double k_max = energy_->layout().bound;
   *k = k->cwiseMax(-k_max).cwiseMin(k_max);
   SolverSummary summary;
   summary.solver = EnumToString(options_.type);

@@ -32,7 +32,7 @@ Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& opt
   options.Check();
   const int n = energy->num_parameters();
   if (options.samples == 0) return Eigen::VectorXd::Zero(n);
-  const double k_max = energy->options().k_max;
+  const double k_max = energy->layout().bound;
   const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
   Eigen::MatrixXd costs = SweepCosts(energy, displacements);
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);

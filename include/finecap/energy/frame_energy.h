@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/energy/energy_options.h"
+#include "finecap/energy/parameter_layout.h"
 #include "finecap/energy/quadratic_term.h"
 #include "finecap/energy/regularizer.h"
 #include "finecap/energy/similarity.h"
@@ -72,6 +73,8 @@ class FrameEnergy {
   FrameEnergy& operator=(const FrameEnergy&) = delete;
 
   int num_parameters() const { return surface_.size(); }
+  // The unknowns: num_parameters() displacements within [-k_max, k_max].
+  ParameterLayout layout() const { return {num_parameters(), options_.k_max}; }
   const SurfaceGaussians& surface() const { return surface_; }
   const EnergyOptions& options() const { return options_; }
   // The cameras' pair lists, without their image Gaussian ids, and without the image Gaussians
