@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "finecap/config/config.h"
+#include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
 #include "finecap/util/option_fields.h"
 #include "test_util.h"
@@ -22,8 +23,9 @@
 namespace finecap {
 namespace {
 
-// Keys of settings that no library struct holds (where the input is, where the output goes, the
-// threads, what eval shows): the schema alone checks them.
+// Keys of settings that Config::Check() does not reach (where the input is, where the output goes,
+// the threads, what eval shows, the reference frame): the schema checks them, and the library
+// struct that holds one, if any (SequenceOptions, RunEvaluationOptions), when a command runs.
 bool IsConfigLevelKey(const std::string& path) {
   for (const char* prefix : {"capture.", "output.", "runtime.", "eval.", "compare."}) {
     if (path.rfind(prefix, 0) == 0) return true;
@@ -116,7 +118,9 @@ std::vector<std::pair<std::string, std::vector<OptionField>>> DeclaredFields() {
           {"SkirtOptions::", SkirtOptions::Fields().Declared()},
           {"TextureOptions::", TextureOptions::Fields().Declared()},
           {"RigOptions::", RigOptions::Fields().Declared()},
-          {"RenderOptions::", RenderOptions::Fields().Declared()}};
+          {"RenderOptions::", RenderOptions::Fields().Declared()},
+          {"SequenceOptions::", SequenceOptions::Fields().Declared()},
+          {"RunEvaluationOptions::", RunEvaluationOptions::Fields().Declared()}};
 }
 
 // A declared bound as the schema states it: an unbounded side of an int is the int's limit.

@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "finecap/eval/optical_flow.h"
+#include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
 #include "refine/scene_scale.h"
 
@@ -127,14 +128,10 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
         config->runtime.shard = ParseShard(value.Scalar(), where);
       },
       [config] { return config->runtime.shard.ToString(); });
-  schema->AddInt(
-      "runtime.max_memory_mb", &config->runtime.max_memory_mb,
-      "finecap refine: refuse, before it starts, a run whose forecast peak memory "
-      "exceeds this many MB; 0 = the memory available (the smaller of the cgroup limit and "
-      "MemAvailable), which is always checked.",
-      0);
-  schema->AddInt("eval.camera", &config->eval.camera,
-                 "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
+  schema->AddDeclaredInt("runtime.max_memory_mb", &config->runtime.max_memory_mb,
+                         SequenceOptions::Fields().Field("max_memory_mb"));
+  schema->AddDeclaredInt("eval.camera", &config->eval.camera,
+                         RunEvaluationOptions::Fields().Field("camera"));
   schema->AddChoice("eval.flow", &config->eval.flow,
                     "finecap eval: optical flow between the textured model's render and the "
                     "image (the paper's section 7): dis, deepflow (slower) or none.",
@@ -150,10 +147,8 @@ void AddCaptureOutputRuntimeKeys(Config* config, ConfigSchema* schema) {
 
 void AddModelKeys(Config* config, ConfigSchema* schema) {
   RefineOptions& refine = config->refine;
-  schema->AddInt("model.reference_frame", &config->reference_frame,
-                 "Frame (index in the sorted frame list) whose images colour the surface "
-                 "Gaussians; the paper: the first.",
-                 0);
+  schema->AddDeclaredInt("model.reference_frame", &config->reference_frame,
+                         SequenceOptions::Fields().Field("reference_frame"));
   schema->AddFields("model.", &config->colors, ReferenceColorOptions::Fields());
   schema->AddFields("model.", &refine, RefineOptions::ModelFields(),
                     {{"sigma_hat", AutoLengthKey(&refine.sigma_hat, &refine.scene_lengths.sigma_hat,

@@ -346,6 +346,11 @@ class ConfigSchema::FieldKeyAdder : public OptionFieldVisitor {
   std::set<std::string> used_;
 };
 
+void ConfigSchema::AddDeclaredInt(const std::string& path, int* field,
+                                  const OptionField& declared) {
+  AddInt(path, field, declared.doc, IntMin(declared), IntMax(declared));
+}
+
 void ConfigSchema::AddFieldKeys(const std::string& prefix,
                                 const std::function<void(OptionFieldVisitor*)>& visit_fields,
                                 const std::map<std::string, FieldKeyMaker>& special) {

@@ -71,6 +71,10 @@ class ConfigSchema {
         special);
   }
 
+  // An int key bound to `*field` (the config's own copy of a library field) with the range and doc
+  // that `declared` states.
+  void AddDeclaredInt(const std::string& path, int* field, const OptionField& declared);
+
   // A key of any other type: `assign` parses and checks a YAML value and writes the field,
   // throwing Error(where, problem) on failure; `current_text` prints the field as YAML.
   void AddCustom(const std::string& path, const std::string& type, const std::string& range,

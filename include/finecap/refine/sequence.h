@@ -65,8 +65,9 @@ struct SequenceOptions {
   // How each frame is refined. Its lengths should be resolved from the scene first
   // (ResolveSceneScaleDefaults, scene_scale.h).
   RefineOptions refine;
-  // The frame whose images colour the surface Gaussians of every frame (model.reference_frame).
-  // Default 0.
+  // The frame whose images colour the surface Gaussians of every frame. Its documentation and
+  // max_memory_mb's are where Fields() declares them (docs/configuration.md: model.reference_frame,
+  // runtime.max_memory_mb).
   int reference_frame = 0;
   // How the colours are taken and kept over the sequence.
   ReferenceColorOptions colors;
@@ -80,11 +81,11 @@ struct SequenceOptions {
   bool skip_unreadable_cameras = false;
   // How the refined meshes are written. Default PLY.
   MeshFormat mesh_format = MeshFormat::kPly;
-  // A run whose forecast peak memory (EstimateProblemSize) exceeds this many megabytes, or the
-  // memory available to the process (ReadAvailableMemory), is refused before it reads more than
-  // its first frame or writes anything. 0: only the memory available. Default 0.
+  // The forecast is EstimateProblemSize's, the memory available ReadAvailableMemory's. A run is
+  // refused before it reads more than its first frame or writes anything.
   int max_memory_mb = 0;
 
+  static const OptionFields<SequenceOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
