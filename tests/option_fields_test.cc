@@ -3,7 +3,6 @@
 // schema makes of it.
 #include "finecap/util/option_fields.h"
 
-#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>

@@ -296,14 +296,16 @@ class ConfigSchema::FieldKeyAdder : public OptionFieldVisitor {
     }
   }
   void Double(const OptionField& field, double* value) override {
-    if (!MadeAsSpecial(field))
-      schema_->AddDouble(Path(field), value, field.doc, field.min, field.max);
+    if (MadeAsSpecial(field)) return;
+    schema_->AddDouble(Path(field), value, field.doc, field.min, field.max);
   }
   void Bool(const OptionField& field, bool* value) override {
-    if (!MadeAsSpecial(field)) schema_->AddBool(Path(field), value, field.doc);
+    if (MadeAsSpecial(field)) return;
+    schema_->AddBool(Path(field), value, field.doc);
   }
   void String(const OptionField& field, std::string* value) override {
-    if (!MadeAsSpecial(field)) schema_->AddString(Path(field), value, field.doc);
+    if (MadeAsSpecial(field)) return;
+    schema_->AddString(Path(field), value, field.doc);
   }
   void DoubleList(const OptionField& field, std::vector<double>* value) override {
     if (MadeAsSpecial(field)) return;
@@ -322,7 +324,8 @@ class ConfigSchema::FieldKeyAdder : public OptionFieldVisitor {
 
   // Refuses a special key maker for a field that was never visited (a misspelt name).
   void RequireEverySpecialUsed() const {
-    for (const auto& [name, make] : special_) {
+    for (const auto& special : special_) {
+      const std::string& name = special.first;
       Require(used_.count(name) > 0, prefixes_.front() + name,
               "a special key maker for a field that is not declared");
     }
