@@ -1,10 +1,12 @@
-// One home per option: the config schema and the options structs' Check()s agree on every range,
-// a Check() names the C++ field and the config layer reports it at its key, choices are enums
-// whose names come from one table, and a renamed key keeps its former name.
+// One home per option: every numeric key takes its range from its options struct's declaration of
+// fields (option_fields.h), whose Check() refuses what lies past it naming the C++ field, which
+// the config layer reports at its key; choices are enums whose names come from one table, and a
+// renamed key keeps its former name.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -13,14 +15,17 @@
 #include <gtest/gtest.h>
 
 #include "finecap/config/config.h"
+#include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
+#include "finecap/util/option_fields.h"
 #include "test_util.h"
 
 namespace finecap {
 namespace {
 
-// Keys of settings that no library struct holds (where the input is, where the output goes, the
-// threads, what eval shows): the schema alone checks them.
+// Keys of settings that Config::Check() does not reach (where the input is, where the output goes,
+// the threads, what eval shows, the reference frame): the schema checks them, and the library
+// struct that holds one, if any (SequenceOptions, RunEvaluationOptions), when a command runs.
 bool IsConfigLevelKey(const std::string& path) {
   for (const char* prefix : {"capture.", "output.", "runtime.", "eval.", "compare."}) {
     if (path.rfind(prefix, 0) == 0) return true;
@@ -94,11 +99,75 @@ EdgeValues Edges(const ConfigSchema::NumericKey& key) {
   return edges;
 }
 
-// For every numeric key of a library struct: a value at the edge of the schema's range passes
+// The declared fields of every options struct the config reads, with the prefix its Check()
+// names them by.
+std::vector<std::pair<std::string, std::vector<OptionField>>> DeclaredFields() {
+  return {{"RefineOptions::", RefineOptions::ModelFields().Declared()},
+          {"RefineOptions::", RefineOptions::RunFields().Declared()},
+          {"ReferenceColorOptions::", ReferenceColorOptions::Fields().Declared()},
+          {"ImageGaussianOptions::", ImageGaussianOptions::Fields().Declared()},
+          {"VisibilityOptions::", VisibilityOptions::Fields().Declared()},
+          {"EnergyOptions::", EnergyOptions::Fields().Declared()},
+          {"ConsensusOptions::", ConsensusOptions::Fields().Declared()},
+          {"SolverOptions::", SolverOptions::Fields().Declared()},
+          {"SweepOptions::", SweepOptions::Fields().Declared()},
+          {"CoarseToFineOptions::", CoarseToFineOptions::Fields().Declared()},
+          {"HeldOutOptions::", HeldOutOptions::Fields().Declared()},
+          {"SynthOptions::", SynthOptions::Fields().Declared()},
+          {"SynthOptions::smoothing.", TaubinSmoothingOptions::Fields().Declared()},
+          {"SkirtOptions::", SkirtOptions::Fields().Declared()},
+          {"TextureOptions::", TextureOptions::Fields().Declared()},
+          {"RigOptions::", RigOptions::Fields().Declared()},
+          {"RenderOptions::", RenderOptions::Fields().Declared()},
+          {"SequenceOptions::", SequenceOptions::Fields().Declared()},
+          {"RunEvaluationOptions::", RunEvaluationOptions::Fields().Declared()}};
+}
+
+// A declared bound as the schema states it: an unbounded side of an int is the int's limit.
+double DeclaredMin(const OptionField& field) {
+  if (field.HasMin() || field.type == OptionField::Type::kDouble) return field.min;
+  return std::numeric_limits<int>::lowest();
+}
+
+double DeclaredMax(const OptionField& field) {
+  if (field.HasMax() || field.type == OptionField::Type::kDouble) return field.max;
+  return std::numeric_limits<int>::max();
+}
+
+// Every declared number is a key, a numeric key has its field's declared range, and no numeric
+// key of a library struct has a range of its own: written in the config, it could drift from
+// what Check() enforces.
+TEST(ConfigOptionsTest, EveryNumericKeyHasTheRangeDeclaredByItsStruct) {
+  Config defaults;
+  const ConfigSchema schema = MakeConfigSchema(&defaults);
+  std::map<std::string, ConfigSchema::NumericKey> numeric_keys;
+  for (const ConfigSchema::NumericKey& key : schema.NumericKeys()) numeric_keys[key.path] = key;
+  std::set<std::string> declared_keys;
+  for (const auto& [prefix, fields] : DeclaredFields()) {
+    for (const OptionField& field : fields) {
+      if (!field.IsNumber()) continue;
+      const std::string key = ConfigKeyOfField(prefix + field.name);
+      ASSERT_TRUE(schema.Has(key)) << prefix << field.name << " has no key";
+      declared_keys.insert(key);
+      const auto numeric = numeric_keys.find(key);
+      if (numeric == numeric_keys.end()) continue;  // A key of its own parsing (an odd window).
+      EXPECT_EQ(numeric->second.min, DeclaredMin(field)) << key;
+      EXPECT_EQ(numeric->second.max, DeclaredMax(field)) << key;
+      EXPECT_EQ(numeric->second.zero_also, field.zero_also) << key;
+    }
+  }
+  for (const auto& [path, key] : numeric_keys) {
+    if (IsConfigLevelKey(path)) continue;
+    EXPECT_EQ(declared_keys.count(path), 1u) << path << " states a range of its own";
+  }
+  EXPECT_GT(declared_keys.size(), 70u);
+}
+
+// For every numeric key of a library struct: a value at the edge of the key's range passes
 // Config::Check() (or fails it naming another key, when a rule across keys refuses it with the
-// others at their defaults), and one just outside fails Check() naming this key, so that neither
-// a library caller nor a config can set what the other refuses.
-TEST(ConfigOptionsTest, ChecksAgreeWithTheSchemaRanges) {
+// others at their defaults), and one just outside, written past the schema's checks, fails Check()
+// naming this key: the struct's Check() enforces every range it declares.
+TEST(ConfigOptionsTest, CheckRefusesAValueJustPastEachBoundOfEveryNumericKey) {
   Config defaults;
   const ConfigSchema schema = MakeConfigSchema(&defaults);
   ASSERT_EQ(FailingKey(defaults), "");

@@ -1,6 +1,7 @@
 #include "finecap/config/config_schema.h"
 
 #include <cmath>
+#include <set>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -265,6 +266,100 @@ void ConfigSchema::AddAlias(const std::string& old_path, const std::string& path
   alias.alias_of = path;
   alias.is_numeric = false;
   AddKey(std::move(alias));
+}
+
+namespace {
+
+int IntMin(const OptionField& field) {
+  return field.HasMin() ? static_cast<int>(field.min) : std::numeric_limits<int>::lowest();
+}
+
+int IntMax(const OptionField& field) {
+  return field.HasMax() ? static_cast<int>(field.max) : std::numeric_limits<int>::max();
+}
+
+}  // namespace
+
+// Adds the key of each field it visits, or leaves it to the caller's maker of special keys.
+class ConfigSchema::FieldKeyAdder : public OptionFieldVisitor {
+ public:
+  FieldKeyAdder(ConfigSchema* schema, const std::string& prefix,
+                const std::map<std::string, FieldKeyMaker>& special)
+      : schema_(schema), prefixes_{prefix}, special_(special) {}
+
+  void Int(const OptionField& field, int* value) override {
+    if (MadeAsSpecial(field)) return;
+    if (field.zero_also) {
+      schema_->AddIntOrOff(Path(field), value, field.doc, IntMin(field), IntMax(field));
+    } else {
+      schema_->AddInt(Path(field), value, field.doc, IntMin(field), IntMax(field));
+    }
+  }
+  void Double(const OptionField& field, double* value) override {
+    if (MadeAsSpecial(field)) return;
+    schema_->AddDouble(Path(field), value, field.doc, field.min, field.max);
+  }
+  void Bool(const OptionField& field, bool* value) override {
+    if (MadeAsSpecial(field)) return;
+    schema_->AddBool(Path(field), value, field.doc);
+  }
+  void String(const OptionField& field, std::string* value) override {
+    if (MadeAsSpecial(field)) return;
+    schema_->AddString(Path(field), value, field.doc);
+  }
+  void DoubleList(const OptionField& field, std::vector<double>* value) override {
+    if (MadeAsSpecial(field)) return;
+    schema_->AddDoubleList(Path(field), value, field.doc, field.min, field.max);
+  }
+  void Choice(const OptionField& field, std::function<void(const std::string&)> set,
+              std::function<std::string()> get) override {
+    if (MadeAsSpecial(field)) return;
+    schema_->AddChoiceKey(Path(field), field.doc, field.choices, std::move(set), std::move(get));
+  }
+  void Custom(const OptionField& field) override {
+    Require(MadeAsSpecial(field), Path(field), "a custom option field without a key maker");
+  }
+  void BeginSection(const OptionField& field) override { prefixes_.push_back(Path(field) + "."); }
+  void EndSection() override { prefixes_.pop_back(); }
+
+  // Refuses a special key maker for a field that was never visited (a misspelt name).
+  void RequireEverySpecialUsed() const {
+    for (const auto& special : special_) {
+      const std::string& name = special.first;
+      Require(used_.count(name) > 0, prefixes_.front() + name,
+              "a special key maker for a field that is not declared");
+    }
+  }
+
+ private:
+  std::string Path(const OptionField& field) const { return prefixes_.back() + field.name; }
+
+  bool MadeAsSpecial(const OptionField& field) {
+    const std::string path = Path(field);
+    const auto special = special_.find(path.substr(prefixes_.front().size()));
+    if (special == special_.end()) return false;
+    special->second(path, field);
+    used_.insert(special->first);
+    return true;
+  }
+
+  ConfigSchema* schema_;
+  std::vector<std::string> prefixes_;  // The first is the caller's; one more per open section.
+  const std::map<std::string, FieldKeyMaker>& special_;
+  std::set<std::string> used_;
+};
+
+void ConfigSchema::AddDeclaredInt(const std::string& path, int* field,
+                                  const OptionField& declared) {
+  AddInt(path, field, declared.doc, IntMin(declared), IntMax(declared));
+}
+
+void ConfigSchema::AddFieldKeys(const std::string& prefix,
+                                const std::function<void(OptionFieldVisitor*)>& visit_fields,
+                                const std::map<std::string, FieldKeyMaker>& special) {
+  FieldKeyAdder adder(this, prefix, special);
+  visit_fields(&adder);
+  adder.RequireEverySpecialUsed();
 }
 
 std::vector<ConfigSchema::NumericKey> ConfigSchema::NumericKeys() const {

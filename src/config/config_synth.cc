@@ -1,14 +1,16 @@
-// The keys of section `synth`: every field of SynthOptions, named as in configs/synth_*.yaml.
+// The keys of section `synth`: every field of SynthOptions, as SynthOptions::Fields() declares it.
 //
-// Most keys are plain numbers, flags and choices. Four kinds need their own parsing, done here
-// through ConfigSchema::AddCustom: the 64-bit seeds, lists of a fixed length (lens distortion,
-// colours, a light direction) and the list of fold families, whose items are mappings.
+// Most keys are plain numbers, flags and choices. The custom fields need their own parsing, done
+// here through ConfigSchema::AddCustom: the 64-bit seeds, lists of a fixed length (lens
+// distortion, colours, a light direction) and the list of fold families, whose items are mappings
+// of FoldComponent's declared fields.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
@@ -104,11 +106,6 @@ void AddFixedList(ConfigSchema* schema, const std::string& path, double* values,
       [=] { return ListText(values, size); });
 }
 
-void AddVector3(ConfigSchema* schema, const std::string& path, Eigen::Vector3d* field,
-                const std::string& doc, double min = kNoMin, double max = kNoMax) {
-  AddFixedList(schema, path, field->data(), 3, doc, min, max);
-}
-
 // Seeds are 64-bit unsigned: an int key would cut their range in half.
 void AddSeed(ConfigSchema* schema, const std::string& path, std::uint64_t* field,
              const std::string& doc) {
@@ -126,36 +123,56 @@ void AddSeed(ConfigSchema* schema, const std::string& path, std::uint64_t* field
 
 // ---- Folds ----
 
-// A numeric field of FoldComponent with its YAML name and allowed range (as FoldComponent::Check).
-struct FoldNumber {
-  const char* name;
-  double FoldComponent::*field;
-  double min;
-  double max;
+// Reads the key `name` of a fold mapping into the field of that name (FoldComponent::Fields()).
+class FoldFieldReader : public OptionFieldVisitor {
+ public:
+  FoldFieldReader(std::string name, YAML::Node value, std::string where)
+      : name_(std::move(name)), value_(std::move(value)), where_(std::move(where)) {}
+
+  void Double(const OptionField& field, double* number) override {
+    if (Claim(field)) *number = ParseNumber(value_, where_, field.min, field.max);
+  }
+  void Choice(const OptionField& field, std::function<void(const std::string&)> set,
+              std::function<std::string()>) override {
+    if (Claim(field)) set(ParseChoice(value_, where_, field.choices));
+  }
+  bool found() const { return found_; }
+
+ private:
+  bool Claim(const OptionField& field) {
+    found_ = found_ || field.name == name_;
+    return field.name == name_;
+  }
+
+  const std::string name_;
+  const YAML::Node value_;
+  const std::string where_;
+  bool found_ = false;
 };
 
-const FoldNumber kFoldNumbers[] = {
-    {"amplitude", &FoldComponent::amplitude, -0.1, 0.1},
-    {"wavelength", &FoldComponent::wavelength, 0.01, 2.0},
-    {"orientation", &FoldComponent::orientation, kNoMin, kNoMax},
-    {"phase", &FoldComponent::phase, kNoMin, kNoMax},
-    {"drift", &FoldComponent::drift, kNoMin, kNoMax},
-};
-const char kFoldKeys[] = "amplitude, wavelength, orientation, phase, drift, profile";
+// Writes a fold's fields as YAML flow entries, "amplitude: 0.008, ..., profile: sine".
+class FoldFieldWriter : public OptionFieldVisitor {
+ public:
+  void Double(const OptionField& field, double* number) override {
+    Append(field.name + ": " + NumberText(*number));
+  }
+  void Choice(const OptionField& field, std::function<void(const std::string&)>,
+              std::function<std::string()> get) override {
+    Append(field.name + ": " + get());
+  }
+  const std::string& text() const { return text_; }
 
-void ParseFoldField(const std::string& name, const YAML::Node& value, const std::string& where,
-                    FoldComponent* fold) {
-  if (name == "profile") {
-    StringToEnum(ParseChoice(value, where, EnumNameList<FoldProfile>()), &fold->profile);
-    return;
+ private:
+  void Append(const std::string& entry) { text_ += (text_.empty() ? "" : ", ") + entry; }
+  std::string text_;
+};
+
+std::string FoldKeys() {
+  std::string keys;
+  for (const OptionField& field : FoldComponent::Fields().Declared()) {
+    keys += (keys.empty() ? "" : ", ") + field.name;
   }
-  for (const FoldNumber& number : kFoldNumbers) {
-    if (name == number.name) {
-      fold->*number.field = ParseNumber(value, where, number.min, number.max);
-      return;
-    }
-  }
-  throw Error(where, std::string("unknown fold key (known: ") + kFoldKeys + ")");
+  return keys;
 }
 
 // One item of `folds`: a mapping of some of the fold keys; absent keys keep their defaults.
@@ -164,7 +181,10 @@ FoldComponent ParseFold(const YAML::Node& item, const std::string& where) {
   FoldComponent fold;
   for (const auto& entry : item) {
     const std::string name = ScalarText(entry.first, where);
-    ParseFoldField(name, entry.second, SubKeyWhere(where, "." + name), &fold);
+    FoldFieldReader reader(name, entry.second, SubKeyWhere(where, "." + name));
+    FoldComponent::Fields().Visit(&fold, &reader);
+    Require(reader.found(), SubKeyWhere(where, "." + name),
+            "unknown fold key (known: " + FoldKeys() + ")");
   }
   return fold;
 }
@@ -181,185 +201,57 @@ std::vector<FoldComponent> ParseFolds(const YAML::Node& value, const std::string
 }
 
 // YAML flow syntax, e.g. [{amplitude: 0.008, wavelength: 0.12, ..., profile: sine}].
-std::string FoldsText(const std::vector<FoldComponent>& folds) {
+std::string FoldsText(std::vector<FoldComponent> folds) {
   std::string text = "[";
   for (size_t i = 0; i < folds.size(); ++i) {
-    text += i ? ", {" : "{";
-    for (const FoldNumber& number : kFoldNumbers) {
-      text += std::string(number.name) + ": " + NumberText(folds[i].*number.field) + ", ";
-    }
-    text += "profile: " + EnumToString(folds[i].profile) + "}";
+    FoldFieldWriter writer;
+    FoldComponent::Fields().Visit(&folds[i], &writer);
+    text += (i ? ", {" : "{") + writer.text() + "}";
   }
   return text + "]";
 }
 
-void AddFoldsKey(std::vector<FoldComponent>* folds, ConfigSchema* schema) {
-  schema->AddCustom(
-      "synth.folds", "list of folds", std::string("{") + kFoldKeys + "}",
-      "Fold families, summed: amplitude m, wavelength m, orientation deg (0 = crests run "
-      "down), phase deg, drift deg/frame, profile sine or ridge.",
-      [folds](const YAML::Node& value, const std::string& where) {
-        *folds = ParseFolds(value, where);
-      },
-      [folds] { return FoldsText(*folds); });
+// ---- Keys of their own ----
+
+ConfigSchema::FieldKeyMaker FoldsKey(std::vector<FoldComponent>* folds, ConfigSchema* schema) {
+  return [=](const std::string& path, const OptionField& field) {
+    schema->AddCustom(
+        path, "list of folds", "{" + FoldKeys() + "}", field.doc,
+        [folds](const YAML::Node& value, const std::string& where) {
+          *folds = ParseFolds(value, where);
+        },
+        [folds] { return FoldsText(*folds); });
+  };
 }
 
-// ---- Coarse input ----
-
-void AddCoarseInputKeys(SynthOptions* synth, ConfigSchema* schema) {
-  schema->AddEnum("synth.coarse", &synth->coarse,
-                  "The coarse meshes: unfolded (the true surface without its folds), smoothed "
-                  "(the true surface Taubin-smoothed, synth.smoothing) or exact (the true "
-                  "surface at the coarse vertices, the detail between them missing).");
-  TaubinSmoothingOptions& smoothing = synth->smoothing;
-  schema->AddInt("synth.smoothing.iterations", &smoothing.iterations,
-                 "synth.coarse smoothed: Taubin iterations (lambda and mu step each), the "
-                 "strength of the smoothing.",
-                 1, 100000);
-  schema->AddDouble("synth.smoothing.lambda", &smoothing.lambda, "Taubin's shrinking step factor.",
-                    1e-3, 1.0);
-  schema->AddDouble("synth.smoothing.mu", &smoothing.mu,
-                    "Taubin's inflating step factor (negative, usually slightly larger in "
-                    "magnitude than lambda; (1 - 2 lambda)(1 - 2 mu) >= -1).",
-                    -1.0, 0.0);
+ConfigSchema::FieldKeyMaker FixedListKey(double* values, int size, ConfigSchema* schema) {
+  return [=](const std::string& path, const OptionField& field) {
+    AddFixedList(schema, path, values, size, field.doc, field.min, field.max);
+  };
 }
 
-// ---- Sections ----
-
-void AddSkirtKeys(SkirtOptions* skirt, ConfigSchema* schema) {
-  schema->AddDouble("synth.skirt.waist_radius", &skirt->waist_radius,
-                    "Radius of the skirt at the waist (top), m.", 0.01, 5.0);
-  schema->AddDouble("synth.skirt.hem_radius", &skirt->hem_radius,
-                    "Radius of the skirt at the hem (bottom), m; >= waist_radius.", 0.01, 5.0);
-  schema->AddDouble("synth.skirt.length", &skirt->length, "Height from waist to hem, m.", 0.01,
-                    10.0);
-  schema->AddDouble("synth.skirt.flare_exponent", &skirt->flare_exponent,
-                    "Radius grows like s^p from waist (s = 0) to hem (s = 1); 1 is a cone.", 1.0,
-                    10.0);
-  schema->AddDouble("synth.skirt.waist_height", &skirt->waist_height,
-                    "Height of the waist above the floor (world y), m.");
-  schema->AddInt("synth.skirt.around", &skirt->around, "Coarse mesh vertices around the tube.", 8,
-                 100000);
-  schema->AddInt("synth.skirt.down", &skirt->down, "Coarse mesh vertices from waist to hem.", 3,
-                 100000);
-  schema->AddDouble("synth.skirt.sway", &skirt->sway, "Peak sideways sway of the hem, m.", 0.0,
-                    1.0);
-  schema->AddDouble("synth.skirt.swing", &skirt->swing,
-                    "Peak twist of the hem about the vertical axis, degrees.", -90.0, 90.0);
-  schema->AddDouble("synth.skirt.flare_wobble", &skirt->flare_wobble,
-                    "Peak relative difference of the hem outline's radii from round (fraction).",
-                    0.0, 0.5);
-  schema->AddDouble("synth.skirt.period", &skirt->period,
-                    "Frames per cycle of the low-frequency motion.", 1e-3, 1e9);
-}
-
-void AddGeometryKeys(SynthOptions* synth, ConfigSchema* schema) {
-  schema->AddString("synth.mesh_path", &synth->mesh_path,
-                    "Subject \"mesh\": a mesh file or a folder of per-frame meshes of one "
-                    "topology (.ply, .obj, .off, .stl); world y up.");
-  schema->AddInt("synth.num_frames", &synth->num_frames,
-                 "Frames to generate (at most the meshes in a mesh_path folder).", 1, 1000000);
-  schema->AddInt("synth.truth_refinement", &synth->truth_refinement,
-                 "True surface edges per coarse edge (a power of two for subject \"mesh\").", 1,
-                 16);
-  AddFoldsKey(&synth->folds, schema);
-  schema->AddDouble("synth.single_wavelength", &synth->single_wavelength,
-                    "When > 0, every fold gets this wavelength, m (0.01 to 2); 0 = off.", 0.0, 2.0);
-  schema->AddInt("synth.fold_ramp_frames", &synth->fold_ramp_frames,
-                 "Folds grow from zero at frame 0 to full at this frame; 0 = full from frame 0 "
-                 "(a ramp leaves the reference frame's coarse mesh exact).",
-                 0);
-  schema->AddDouble("synth.misalignment", &synth->misalignment,
-                    "Peak of the smooth random displacement added to the coarse meshes, m.", 0.0,
-                    0.1);
-  schema->AddDouble("synth.misalignment_wavelength", &synth->misalignment_wavelength,
-                    "Spatial wavelength of that displacement field, m.", 0.01, 100.0);
-  schema->AddDouble("synth.max_displacement", &synth->max_displacement,
-                    "Largest |k| searched along a coarse normal for the true surface, m; "
-                    "farther is a miss.",
-                    1e-4, 10.0);
-}
-
-void AddTextureKeys(TextureOptions* texture, ConfigSchema* schema) {
-  schema->AddInt("synth.texture.width", &texture->width, "Texture width, texels (around).", 16,
-                 16384);
-  schema->AddInt("synth.texture.height", &texture->height, "Texture height, texels (down).", 16,
-                 16384);
-  schema->AddEnum("synth.texture.pattern", &texture->pattern,
-                  "Cloth print: plaid, motifs and noise mixed, or one of them alone.");
-  schema->AddDouble("synth.texture.textureless_begin", &texture->textureless_begin,
-                    "Start of the plain band, fraction of the height from the top.", 0.0, 1.0);
-  schema->AddDouble("synth.texture.textureless_end", &texture->textureless_end,
-                    "End of the plain band, fraction of the height (equal to begin: no band).", 0.0,
-                    1.0);
-  AddVector3(schema, "synth.texture.textureless_color", &texture->textureless_color,
-             "Colour of the plain band, RGB in [0, 1].", 0.0, 1.0);
-}
-
-void AddRigKeys(RigOptions* rig, ConfigSchema* schema) {
-  schema->AddInt("synth.cameras.count", &rig->count,
-                 "Cameras, evenly spaced on a ring around the subject.", 1, 1000);
-  schema->AddInt("synth.cameras.width", &rig->width, "Image width, pixels.", 16, 20000);
-  schema->AddInt("synth.cameras.height", &rig->height, "Image height, pixels.", 16, 20000);
-  schema->AddDouble("synth.cameras.focal", &rig->focal, "Focal length, pixels.", 1.0, 1e6);
-  schema->AddDouble("synth.cameras.distance", &rig->distance,
-                    "Horizontal distance of the cameras from the subject's axis, m.", 0.05, 1e4);
-  schema->AddDoubleList("synth.cameras.heights", &rig->heights,
-                        "Camera heights above the subject's centre, m; camera c uses entry "
-                        "c % size (non-empty).");
-  AddFixedList(schema, "synth.cameras.distortion", rig->distortion.data(),
-               static_cast<int>(rig->distortion.size()),
-               "Lens distortion (k1, k2, p1, p2, k3) of every camera, OpenCV's model.", -10.0,
-               10.0);
-  schema->AddDouble("synth.cameras.rotation_noise", &rig->rotation_noise,
-                    "Calibration error: rotation standard deviation per axis, degrees.", 0.0, 10.0);
-  schema->AddDouble("synth.cameras.translation_noise", &rig->translation_noise,
-                    "Calibration error: centre offset standard deviation per axis, m.", 0.0, 1.0);
-  schema->AddDouble("synth.cameras.focal_noise", &rig->focal_noise,
-                    "Calibration error: relative focal length standard deviation.", 0.0, 0.5);
-}
-
-void AddRenderKeys(RenderOptions* render, ConfigSchema* schema) {
-  schema->AddInt("synth.render.supersampling", &render->supersampling,
-                 "Samples per pixel along each axis (anti-aliasing).", 1, 16);
-  schema->AddBool("synth.render.cull_back_faces", &render->cull_back_faces,
-                  "Skip triangles facing away from the camera (false: the inside of an open "
-                  "surface shows).");
-  schema->AddDouble("synth.render.near_plane", &render->near_plane,
-                    "Camera z of the near clipping plane, m (> 0).", 1e-9);
-  schema->AddBool("synth.render.shade", &render->shade,
-                  "Lambertian shading: colour * (ambient + diffuse * max(0, n . l)).");
-  schema->AddDouble("synth.render.ambient", &render->ambient, "Ambient term of the shading.", 0.0);
-  schema->AddDouble("synth.render.diffuse", &render->diffuse, "Diffuse term of the shading.", 0.0);
-  AddVector3(schema, "synth.render.light_direction", &render->light_direction,
-             "Direction towards the light, world coordinates; non-zero, any length.");
-  AddVector3(schema, "synth.render.background", &render->background,
-             "Colour of pixels that see no surface, RGB in [0, 1].", 0.0, 1.0);
-  schema->AddDouble("synth.render.noise_sigma", &render->noise_sigma,
-                    "Standard deviation of Gaussian sensor noise, 8-bit grey levels.", 0.0, 255.0);
-  AddSeed(schema, "synth.render.noise_seed", &render->noise_seed,
-          "Mixed with synth.seed, the frame and the camera into each image's noise seed.");
+ConfigSchema::FieldKeyMaker SeedKey(std::uint64_t* seed, ConfigSchema* schema) {
+  return [=](const std::string& path, const OptionField& field) {
+    AddSeed(schema, path, seed, field.doc);
+  };
 }
 
 }  // namespace
 
 void AddSynthKeys(SynthOptions* options, ConfigSchema* schema) {
-  schema->AddEnum("synth.subject", &options->subject,
-                  "skirt: the built-in flared tube (synth.skirt); mesh: the meshes at "
-                  "synth.mesh_path.");
-  AddSkirtKeys(&options->skirt, schema);
-  AddGeometryKeys(options, schema);
-  AddCoarseInputKeys(options, schema);
-  AddTextureKeys(&options->texture, schema);
-  AddRigKeys(&options->cameras, schema);
-  AddRenderKeys(&options->render, schema);
-  schema->AddEnum("synth.background", &options->background,
-                  "Around the subject: plain (synth.render.background) or per_camera (a "
-                  "textured wall of its own in every camera).");
-  schema->AddBool("synth.write_masks", &options->write_masks,
-                  "Write the subject's silhouettes as foreground masks (masks/<camera>/).");
-  AddSeed(schema, "synth.seed", &options->seed,
-          "Seed of every random choice (texture, misalignment, calibration and sensor noise).");
+  RigOptions& cameras = options->cameras;
+  RenderOptions& render = options->render;
+  schema->AddFields(
+      "synth.", options, SynthOptions::Fields(),
+      {{"folds", FoldsKey(&options->folds, schema)},
+       {"texture.textureless_color",
+        FixedListKey(options->texture.textureless_color.data(), 3, schema)},
+       {"cameras.distortion", FixedListKey(cameras.distortion.data(),
+                                           static_cast<int>(cameras.distortion.size()), schema)},
+       {"render.light_direction", FixedListKey(render.light_direction.data(), 3, schema)},
+       {"render.background", FixedListKey(render.background.data(), 3, schema)},
+       {"render.noise_seed", SeedKey(&render.noise_seed, schema)},
+       {"seed", SeedKey(&options->seed, schema)}});
 }
 
 }  // namespace finecap

@@ -671,14 +671,24 @@ const char* RefinedFlowTextureName(RefinedFlowTexture texture) {
   return "unknown";
 }
 
+const OptionFields<RunEvaluationOptions>& RunEvaluationOptions::Fields() {
+  static const OptionFields<RunEvaluationOptions> fields = [] {
+    OptionFields<RunEvaluationOptions> f;
+    f.AddInt("camera", &RunEvaluationOptions::camera,
+             "finecap eval: index of the camera whose view the per-frame pictures show.", 0);
+    return f;
+  }();
+  return fields;
+}
+
 void RunEvaluationOptions::Check() const {
   refine.Check();
   held_out_score.Check();
   if (measure_flow) flow.Check();
-  Require(reference_frame >= 0, "RunEvaluationOptions::reference_frame",
-          "must be >= 0, got " + std::to_string(reference_frame));
-  Require(camera >= 0, "RunEvaluationOptions::camera",
-          "must be >= 0, got " + std::to_string(camera));
+  Fields().CheckValues(*this, "RunEvaluationOptions::");
+  // The run's reference frame, as the sequence declares it.
+  internal::CheckDeclaredNumber(reference_frame, SequenceOptions::Fields().Field("reference_frame"),
+                                "RunEvaluationOptions::reference_frame");
 }
 
 RunEvaluation EvaluateRun(Capture* capture, const std::vector<RefinedFrame>& frames,

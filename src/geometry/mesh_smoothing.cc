@@ -9,6 +9,7 @@
 #include <Eigen/SparseCore>
 
 #include "finecap/geometry/mesh_edges.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
@@ -87,6 +88,36 @@ void NormalLaplacianStep(const Eigen::SparseMatrix<double, Eigen::RowMajor>& wei
 }
 
 }  // namespace
+
+const OptionFields<TaubinSmoothingOptions>& TaubinSmoothingOptions::Fields() {
+  static const OptionFields<TaubinSmoothingOptions> fields = [] {
+    OptionFields<TaubinSmoothingOptions> f;
+    f.AddInt("iterations", &TaubinSmoothingOptions::iterations,
+             "synth.coarse smoothed: Taubin iterations (lambda and mu step each), the strength of "
+             "the smoothing.",
+             1, 100000);
+    f.AddDouble("lambda", &TaubinSmoothingOptions::lambda, "Taubin's shrinking step factor.", 1e-3,
+                1.0);
+    f.AddDouble("mu", &TaubinSmoothingOptions::mu,
+                "Taubin's inflating step factor (negative, usually slightly larger in magnitude "
+                "than lambda; (1 - 2 lambda)(1 - 2 mu) >= -1).",
+                -1.0, 0.0);
+    return f;
+  }();
+  return fields;
+}
+
+void TaubinSmoothingOptions::Check(const std::string& where) const {
+  Fields().CheckValues(*this, where + ".");
+  // The fastest wave a mesh carries (Laplacian eigenvalue 2) is scaled by this per iteration;
+  // below -1 it would grow from one iteration to the next instead of fading.
+  const double fastest = (1.0 - 2.0 * lambda) * (1.0 - 2.0 * mu);
+  Require(fastest >= -1.0, where + ".mu",
+          "is " + std::to_string(mu) + " with lambda " + std::to_string(lambda) +
+              ": together they make the smoothing unstable ((1 - 2 lambda)(1 - 2 mu) = " +
+              std::to_string(fastest) + " < -1, the finest detail grows); use a smaller lambda " +
+              "or |mu|");
+}
 
 Eigen::Matrix3Xd TaubinSmooth(const Mesh& mesh, const TaubinSmoothingOptions& options) {
   options.Check("TaubinSmoothingOptions");

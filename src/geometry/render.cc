@@ -316,20 +316,39 @@ void WritePixel(const Eigen::Vector3f& mean_rgb, cv::Vec3b* bgr) {
 
 }  // namespace
 
+const OptionFields<RenderOptions>& RenderOptions::Fields() {
+  static const OptionFields<RenderOptions> fields = [] {
+    OptionFields<RenderOptions> f;
+    f.AddInt("supersampling", &RenderOptions::supersampling,
+             "Samples per pixel along each axis (anti-aliasing).", 1, 16);
+    f.AddBool("cull_back_faces", &RenderOptions::cull_back_faces,
+              "Skip triangles facing away from the camera (false: the inside of an open surface "
+              "shows).");
+    f.AddDouble("near_plane", &RenderOptions::near_plane,
+                "Camera z of the near clipping plane, m (> 0).", 1e-9);
+    f.AddBool("shade", &RenderOptions::shade,
+              "Lambertian shading: colour * (ambient + diffuse * max(0, n . l)).");
+    f.AddDouble("ambient", &RenderOptions::ambient, "Ambient term of the shading.", 0.0);
+    f.AddDouble("diffuse", &RenderOptions::diffuse, "Diffuse term of the shading.", 0.0);
+    f.AddCustom("light_direction",
+                "Direction towards the light, world coordinates; non-zero, any length.");
+    f.AddCustom("background", "Colour of pixels that see no surface, RGB in [0, 1].", 0.0, 1.0);
+    f.AddDouble("noise_sigma", &RenderOptions::noise_sigma,
+                "Standard deviation of Gaussian sensor noise, 8-bit grey levels.", 0.0, 255.0);
+    f.AddCustom("noise_seed",
+                "Mixed with synth.seed, the frame and the camera into each image's noise seed.");
+    return f;
+  }();
+  return fields;
+}
+
 void RenderOptions::Check() const {
   const std::string where = "RenderOptions::";
-  Require(supersampling >= 1 && supersampling <= 16, where + "supersampling",
-          "must be between 1 and 16");
-  Require(std::isfinite(near_plane) && near_plane >= 1e-9, where + "near_plane",
-          "must be at least 1e-9");
-  Require(std::isfinite(ambient) && ambient >= 0.0, where + "ambient", "must be >= 0");
-  Require(std::isfinite(diffuse) && diffuse >= 0.0, where + "diffuse", "must be >= 0");
+  Fields().CheckValues(*this, where);
   Require(light_direction.allFinite() && light_direction.norm() > 0.0, where + "light_direction",
           "must be a finite non-zero vector");
-  Require(background.allFinite() && background.minCoeff() >= 0.0 && background.maxCoeff() <= 1.0,
-          where + "background", "must be RGB in [0, 1]");
-  Require(std::isfinite(noise_sigma) && noise_sigma >= 0.0 && noise_sigma <= 255.0,
-          where + "noise_sigma", "must lie in [0, 255]");
+  internal::CheckDeclaredNumbers(background.data(), 3, Fields().Field("background"),
+                                 where + "background");
 }
 
 DepthMap RenderDepth(const Camera& camera, const Mesh& mesh, const RenderOptions& options) {

@@ -11,18 +11,35 @@
 
 #include "finecap/geometry/render.h"
 #include "finecap/util/error.h"
-#include "util/option_checks.h"
 
 namespace finecap {
 
+const OptionFields<HeldOutOptions>& HeldOutOptions::Fields() {
+  static const OptionFields<HeldOutOptions> fields = [] {
+    OptionFields<HeldOutOptions> f;
+    f.AddInt("neighbours", &HeldOutOptions::neighbours,
+             "Training views warped into each held-out view, the nearest by camera centre.", 1,
+             1000);
+    f.AddInt("window", &HeldOutOptions::window, "Side of the windows of the held-out NCC, pixels.",
+             3, 31);
+    f.AddDouble("min_std", &HeldOutOptions::min_std,
+                "Held-out NCC windows whose grey levels vary less than this (standard deviation, "
+                "0-255) are not scored.",
+                0.0, 255.0);
+    f.AddDouble("depth_tolerance_px", &HeldOutOptions::depth_tolerance_px,
+                "A point counts as seen by a training view within this many pixel footprints "
+                "behind its depth map there.",
+                0.01, 1000.0);
+    return f;
+  }();
+  return fields;
+}
+
 void HeldOutOptions::Check() const {
-  internal::RequireFieldRange(neighbours, 1, 1000, "HeldOutOptions::neighbours");
-  internal::RequireFieldRange(window, 3, 31, "HeldOutOptions::window");
+  Fields().CheckValues(*this, "HeldOutOptions::");
+  // A window has a centre pixel.
   Require(window % 2 == 1, "HeldOutOptions::window",
           "is " + std::to_string(window) + " but must be odd");
-  internal::RequireFieldRange(min_std, 0.0, 255.0, "HeldOutOptions::min_std");
-  internal::RequireFieldRange(depth_tolerance_px, 0.01, 1000.0,
-                              "HeldOutOptions::depth_tolerance_px");
 }
 
 namespace {

@@ -8,7 +8,6 @@
 
 #include "finecap/util/error.h"
 #include "finecap/util/threads.h"
-#include "util/option_checks.h"
 
 namespace finecap {
 namespace {
@@ -428,20 +427,31 @@ int ScanRun(const ImageGaussian* gaussians, int begin, int stop, const NearQuery
 
 }  // namespace
 
+const OptionFields<ImageGaussianOptions>& ImageGaussianOptions::Fields() {
+  static const OptionFields<ImageGaussianOptions> fields = [] {
+    OptionFields<ImageGaussianOptions> f;
+    f.AddEnum("color_space", &ImageGaussianOptions::color_space,
+              "Colour space in which colours are averaged and compared (paper: hsv).");
+    f.AddInt("max_depth", &ImageGaussianOptions::max_depth,
+             "Quad-tree depth: leaves are min_leaf_size * 2^(max_depth - depth) pixels (paper: 8).",
+             0, 16);
+    f.AddInt("min_leaf_size", &ImageGaussianOptions::min_leaf_size,
+             "Side of the smallest quad-tree leaf, pixels (its sigma is half of it).", 1,
+             kMaxMinLeafSize);
+    f.AddDouble("split_threshold", &ImageGaussianOptions::split_threshold,
+                "A square is split while the RMS colour distance of its pixels to their mean "
+                "exceeds this.",
+                0.0, 10.0);
+    return f;
+  }();
+  return fields;
+}
+
 void ImageGaussianOptions::Check() const {
-  const std::string where = "ImageGaussianOptions";
-  internal::RequireKnownChoice(color_space, where + "::color_space");
-  Require(max_depth >= 0 && max_depth <= 16, where + "::max_depth",
-          "must be in [0, 16], got " + std::to_string(max_depth));
-  Require(min_leaf_size >= 1 && min_leaf_size <= kMaxMinLeafSize, where + "::min_leaf_size",
-          "must be in [1, " + std::to_string(kMaxMinLeafSize) + "], got " +
-              std::to_string(min_leaf_size));
-  Require(min_leaf_size <= (kMaxRootSide >> max_depth), where + "::min_leaf_size",
+  Fields().CheckValues(*this, "ImageGaussianOptions::");
+  Require(min_leaf_size <= (kMaxRootSide >> max_depth), "ImageGaussianOptions::min_leaf_size",
           "min_leaf_size * 2^max_depth may not exceed 2^20, got " + std::to_string(min_leaf_size) +
               " * 2^" + std::to_string(max_depth));
-  Require(std::isfinite(split_threshold) && split_threshold >= 0.0 && split_threshold <= 10.0,
-          where + "::split_threshold",
-          "must be in [0, 10], got " + std::to_string(split_threshold));
 }
 
 ImageGaussians::ImageGaussians(int width, int height, ColorSpace color_space,

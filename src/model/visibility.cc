@@ -9,13 +9,34 @@
 
 namespace finecap {
 
+const OptionFields<VisibilityOptions>& VisibilityOptions::Fields() {
+  static const OptionFields<VisibilityOptions> fields = [] {
+    OptionFields<VisibilityOptions> f;
+    f.AddDouble("depth_tolerance", &VisibilityOptions::depth_tolerance,
+                "A vertex more than this behind the rendered input surface is occluded, m", 0.0,
+                10.0);
+    f.AddDouble("max_view_angle_deg", &VisibilityOptions::max_view_angle_deg,
+                "Largest angle between a normal and the direction to a camera that sees it.", 1.0,
+                90.0);
+    f.AddDouble("fallback_view_angle_deg", &VisibilityOptions::fallback_view_angle_deg,
+                "A vertex that fewer cameras see within max_view_angle_deg than the similarity "
+                "compares takes the most frontal up to this angle, with less confidence; equal to "
+                "max_view_angle_deg: none.",
+                1.0, 90.0);
+    f.AddDouble("border_margin", &VisibilityOptions::border_margin,
+                "Vertices projecting closer than this to the image border are not used, px.", 0.0,
+                1000.0);
+    return f;
+  }();
+  return fields;
+}
+
 void VisibilityOptions::Check() const {
-  internal::RequireFieldRange(depth_tolerance, 0.0, 10.0, "VisibilityOptions::depth_tolerance");
-  internal::RequireFieldRange(max_view_angle_deg, 1.0, 90.0,
-                              "VisibilityOptions::max_view_angle_deg");
-  internal::RequireFieldRange(fallback_view_angle_deg, max_view_angle_deg, 90.0,
+  Fields().CheckValues(*this, "VisibilityOptions::");
+  // The fallback widens the cone of the views that max_view_angle_deg admits, never narrows it.
+  internal::RequireFieldRange(fallback_view_angle_deg, max_view_angle_deg,
+                              Fields().Field("fallback_view_angle_deg").max,
                               "VisibilityOptions::fallback_view_angle_deg");
-  internal::RequireFieldRange(border_margin, 0.0, 1000.0, "VisibilityOptions::border_margin");
 }
 
 namespace {

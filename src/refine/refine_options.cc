@@ -1,9 +1,7 @@
-// The Check() of the options structs of refinement (refine.h, the colour options of sequence.h) and
-// the names of their choices (enum_names.h): pure validation, kept apart from the stages' code so
-// that reading a config links none of the stages.
-//
-// Each Check() names the C++ field it refuses; its ranges are the config schema's
-// (config_options_test walks the schema and holds them to it).
+// The options structs of refinement (refine.h, the colour options of sequence.h): the declaration
+// of their fields (option_fields.h), their Check() and the names of their choices (enum_names.h);
+// pure validation, kept apart from the stages' code so that reading a config links none of the
+// stages.
 #include "finecap/energy/energy_options.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/refine/refine.h"
@@ -11,12 +9,8 @@
 #include "finecap/solvers/solver.h"
 #include "finecap/solvers/sweep.h"
 #include "finecap/util/error.h"
-#include "util/option_checks.h"
 
 namespace finecap {
-
-using internal::RequireFieldRange;
-using internal::RequireKnownChoice;
 
 const std::vector<EnumName<ReferenceColorSource>>& EnumNames(ReferenceColorSource) {
   static const std::vector<EnumName<ReferenceColorSource>> names = {
@@ -31,17 +25,71 @@ const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface) {
   return names;
 }
 
+const OptionFields<ReferenceColorOptions>& ReferenceColorOptions::Fields() {
+  static const OptionFields<ReferenceColorOptions> fields = [] {
+    OptionFields<ReferenceColorOptions> f;
+    f.AddEnum("reference_surface", &ReferenceColorOptions::reference_surface,
+              "Where the reference frame colours the surface Gaussians (surface_color, paper): "
+              "coarse (its input surface, the paper) or refined (that frame refined first with "
+              "the default consensus similarity). No effect under consensus.");
+    f.AddDouble("follow_colors", &ReferenceColorOptions::follow_colors,
+                "Rate at which the colours follow the sequence, blended in from each refined "
+                "frame not flagged worse; 0 = fixed at the reference frame (the paper). "
+                "Sequential: not with runtime.shard. No effect under consensus.",
+                0.0, 1.0);
+    f.AddDouble("follow_anchor", &ReferenceColorOptions::follow_anchor,
+                "Pull of the followed colours back towards the reference colours after each "
+                "frame (against drift).",
+                0.0, 1.0);
+    return f;
+  }();
+  return fields;
+}
+
 void ReferenceColorOptions::Check() const {
-  internal::RequireKnownChoice(reference_surface, "ReferenceColorOptions::reference_surface");
-  internal::RequireFieldRange(follow_colors, 0.0, 1.0, "ReferenceColorOptions::follow_colors");
-  internal::RequireFieldRange(follow_anchor, 0.0, 1.0, "ReferenceColorOptions::follow_anchor");
+  Fields().CheckValues(*this, "ReferenceColorOptions::");
+}
+
+const OptionFields<RefineOptions>& RefineOptions::ModelFields() {
+  static const OptionFields<RefineOptions> fields = [] {
+    OptionFields<RefineOptions> f;
+    f.AddInt("subdivision_levels", &RefineOptions::subdivision_levels,
+             "Subdivision levels applied to the coarse mesh before refinement.", 0, 4);
+    f.AddEnum("subdivision", &RefineOptions::subdivision,
+              "Scheme of that subdivision: loop (approximating: moves the input's vertices onto a "
+              "smoother surface), butterfly (modified butterfly, interpolating: keeps them and "
+              "places only the new vertices) or linear (the input's faces split, its surface "
+              "unchanged).");
+    f.AddDouble("sigma_hat", &RefineOptions::sigma_hat,
+                "Standard deviation of every surface Gaussian, metres (paper: 0.007)", 1e-5, 1.0);
+    f.AddEnum("reference_colors", &RefineOptions::reference_colors,
+              "How the reference frame colours the surface Gaussians: pixels (the paper) or "
+              "image_model (what the energy's image model shows in the best camera).");
+    f.AddBool("bias_compensation", &RefineOptions::bias_compensation,
+              "Add sigma_hat along the normal after solving (the paper's shrink compensation).");
+    return f;
+  }();
+  return fields;
+}
+
+const OptionFields<RefineOptions>& RefineOptions::RunFields() {
+  static const OptionFields<RefineOptions> fields = [] {
+    OptionFields<RefineOptions> f;
+    f.AddBool("keep_input_if_worse", &RefineOptions::keep_input_if_worse,
+              "Write the input surface for a frame whose energy, or held-out NCC, got worse "
+              "(always flagged).");
+    f.AddBool("warm_start", &RefineOptions::warm_start,
+              "Start each frame from the previous frame's displacement.");
+    f.AddSection("coarse_to_fine", &RefineOptions::coarse_to_fine, CoarseToFineOptions::Fields());
+    f.AddSection("sweep", &RefineOptions::sweep, SweepOptions::Fields());
+    return f;
+  }();
+  return fields;
 }
 
 void RefineOptions::Check() const {
-  RequireFieldRange(subdivision_levels, 0, 4, "RefineOptions::subdivision_levels");
-  RequireKnownChoice(subdivision, "RefineOptions::subdivision");
-  RequireFieldRange(sigma_hat, 1e-5, 1.0, "RefineOptions::sigma_hat");
-  RequireKnownChoice(reference_colors, "RefineOptions::reference_colors");
+  ModelFields().CheckValues(*this, "RefineOptions::");
+  RunFields().CheckValues(*this, "RefineOptions::");
   image.Check();
   visibility.Check();
   energy.Check();
@@ -50,9 +98,22 @@ void RefineOptions::Check() const {
   coarse_to_fine.Check();
 }
 
-void CoarseToFineOptions::Check() const {
-  RequireFieldRange(levels, 1, 5, "CoarseToFineOptions::levels");
-  RequireFieldRange(scale, 1.0001, 4.0, "CoarseToFineOptions::scale");
+const OptionFields<CoarseToFineOptions>& CoarseToFineOptions::Fields() {
+  static const OptionFields<CoarseToFineOptions> fields = [] {
+    OptionFields<CoarseToFineOptions> f;
+    f.AddInt("levels", &CoarseToFineOptions::levels,
+             "Levels of a coarse-to-fine schedule per frame (wider Gaussians and a coarser image "
+             "model first); 1: off.",
+             1, 5);
+    f.AddDouble("scale", &CoarseToFineOptions::scale,
+                "Factor of sigma_hat and of the smallest quad-tree leaf from one level to the "
+                "next coarser.",
+                1.0001, 4.0);
+    return f;
+  }();
+  return fields;
 }
+
+void CoarseToFineOptions::Check() const { Fields().CheckValues(*this, "CoarseToFineOptions::"); }
 
 }  // namespace finecap

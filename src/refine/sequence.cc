@@ -518,14 +518,28 @@ class SequenceRun {
 
 }  // namespace
 
+const OptionFields<SequenceOptions>& SequenceOptions::Fields() {
+  static const OptionFields<SequenceOptions> fields = [] {
+    OptionFields<SequenceOptions> f;
+    f.AddInt("reference_frame", &SequenceOptions::reference_frame,
+             "Frame (index in the sorted frame list) whose images colour the surface Gaussians; "
+             "the paper: the first.",
+             0);
+    f.AddInt("max_memory_mb", &SequenceOptions::max_memory_mb,
+             "finecap refine: refuse, before it starts, a run whose forecast peak memory exceeds "
+             "this many MB; 0 = the memory available (the smaller of the cgroup limit and "
+             "MemAvailable), which is always checked.",
+             0);
+    return f;
+  }();
+  return fields;
+}
+
 void SequenceOptions::Check() const {
   refine.Check();
   colors.Check();
   held_out_score.Check();
-  Require(max_memory_mb >= 0, "SequenceOptions::max_memory_mb",
-          "must be >= 0 (0: the memory available), got " + std::to_string(max_memory_mb));
-  Require(reference_frame >= 0, "SequenceOptions::reference_frame",
-          "must be >= 0, got " + std::to_string(reference_frame));
+  Fields().CheckValues(*this, "SequenceOptions::");
   for (const std::string& camera : held_out_cameras) {
     Require(!camera.empty(), "SequenceOptions::held_out_cameras", "holds an empty camera name");
   }

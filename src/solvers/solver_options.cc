@@ -1,18 +1,13 @@
-// The Check() of the solvers' options (solver.h, sweep.h) and the names of their choices
-// (enum_names.h): pure validation, apart from the solvers' code. Each Check() names the C++ field
-// it refuses; its ranges are the config schema's (config_options_test walks the schema and holds
-// them to it).
+// The solvers' options (solver.h, sweep.h): the declaration of their fields (option_fields.h),
+// their Check() and the names of their choices (enum_names.h); pure validation, apart from the
+// solvers' code.
 #include <string>
 
 #include "finecap/solvers/solver.h"
 #include "finecap/solvers/sweep.h"
 #include "finecap/util/error.h"
-#include "util/option_checks.h"
 
 namespace finecap {
-
-using internal::RequireFieldRange;
-using internal::RequireKnownChoice;
 
 const std::vector<EnumName<SolverType>>& EnumNames(SolverType) {
   static const std::vector<EnumName<SolverType>> names = {
@@ -43,32 +38,61 @@ const std::vector<EnumName<CurvatureModel>>& EnumNames(CurvatureModel) {
   return names;
 }
 
+const OptionFields<SolverOptions>& SolverOptions::Fields() {
+  static const OptionFields<SolverOptions> fields = [] {
+    OptionFields<SolverOptions> f;
+    f.AddEnum("type", &SolverOptions::type,
+              "ceres (least squares, Levenberg-Marquardt), gradient_ascent (the paper's) or "
+              "lbfgs.");
+    f.AddInt("max_iterations", &SolverOptions::max_iterations,
+             "Most iterations per frame (the paper's ascent: 150).", 0, 100000);
+    f.AddDouble("function_tolerance", &SolverOptions::function_tolerance,
+                "Stop when the energy changes by less than this fraction.", 0.0, 1.0);
+    f.AddEnum("trust_region", &SolverOptions::trust_region, "Ceres' trust-region strategy.");
+    f.AddEnum("linear_solver", &SolverOptions::linear_solver,
+              "Ceres' linear solver: sparse Cholesky (SuiteSparse), conjugate gradients on the "
+              "normal equations, or dense QR (tiny problems only).");
+    f.AddEnum("curvature", &SolverOptions::curvature,
+              "Ceres: curvature of a similarity block's model, Gauss-Newton's J^T J or the secant "
+              "of its gradient between its last two evaluations (within 0.3-3 J^T J).");
+    f.AddDouble("initial_step", &SolverOptions::initial_step,
+                "Gradient ascent: first step of the steepest k_s, m", 1e-9, 1.0);
+    f.AddDouble("step_growth", &SolverOptions::step_growth,
+                "Gradient ascent: step factor growth while a derivative keeps its sign.", 1.0,
+                10.0);
+    f.AddDouble("step_shrink", &SolverOptions::step_shrink,
+                "Gradient ascent: step factor shrink when a derivative flips its sign.", 1e-3,
+                0.999);
+    f.AddDouble("max_step", &SolverOptions::max_step,
+                "Gradient ascent: largest step of one k_s in one iteration, m", 1e-9, 1.0);
+    return f;
+  }();
+  return fields;
+}
+
 void SolverOptions::Check() const {
-  RequireKnownChoice(type, "SolverOptions::type");
-  RequireFieldRange(max_iterations, 0, 100000, "SolverOptions::max_iterations");
-  RequireFieldRange(function_tolerance, 0.0, 1.0, "SolverOptions::function_tolerance");
+  Fields().CheckValues(*this, "SolverOptions::");
   Require(num_threads >= 0, "SolverOptions::num_threads", "must be non-negative (0: all cores)");
-  RequireKnownChoice(trust_region, "SolverOptions::trust_region");
-  RequireKnownChoice(linear_solver, "SolverOptions::linear_solver");
-  RequireKnownChoice(curvature, "SolverOptions::curvature");
-  // Ceres' dogleg needs the exact Gauss-Newton step, which conjugate gradients do not give.
   Require(type != SolverType::kCeres || trust_region != TrustRegionType::kDogleg ||
               linear_solver != LinearSolverType::kCgnr,
           "SolverOptions::trust_region",
           "dogleg needs an exact linear solver (sparse_normal_cholesky or dense_qr), not cgnr");
-  RequireFieldRange(initial_step, 1e-9, 1.0, "SolverOptions::initial_step");
-  RequireFieldRange(step_growth, 1.0, 10.0, "SolverOptions::step_growth");
-  RequireFieldRange(step_shrink, 1e-3, 0.999, "SolverOptions::step_shrink");
-  RequireFieldRange(max_step, 1e-9, 1.0, "SolverOptions::max_step");
 }
 
-void SweepOptions::Check() const {
-  // Fewer than 3 displacements would not include k = 0 and both signs.
-  Require(samples == 0 || (samples >= kMinSamples && samples <= kMaxSamples),
-          "SweepOptions::samples",
-          "is " + std::to_string(samples) + " but must be 0 (off) or lie in [" +
-              std::to_string(kMinSamples) + ", " + std::to_string(kMaxSamples) + "]");
-  RequireFieldRange(smoothing_rounds, 0, 1000, "SweepOptions::smoothing_rounds");
+const OptionFields<SweepOptions>& SweepOptions::Fields() {
+  static const OptionFields<SweepOptions> fields = [] {
+    OptionFields<SweepOptions> f;
+    f.AddIntOrOff("samples", &SweepOptions::samples,
+                  "Plane-sweep start: displacements tried per surface Gaussian before solving "
+                  "(0 = off, start at k = 0).",
+                  kMinSamples, kMaxSamples);
+    f.AddInt("smoothing_rounds", &SweepOptions::smoothing_rounds,
+             "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0, 1000);
+    return f;
+  }();
+  return fields;
 }
+
+void SweepOptions::Check() const { Fields().CheckValues(*this, "SweepOptions::"); }
 
 }  // namespace finecap

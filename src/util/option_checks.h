@@ -1,6 +1,7 @@
-// Helpers of the options structs' Check()s: each names the C++ field it checks
-// ("RefineOptions::sigma_hat"), never a config key (the config layer maps one to the other), and
-// states the allowed values in the problem, which the config schema's ranges agree with.
+// Helpers of the options structs' Check()s for what their declared fields (option_fields.h) do not
+// say, such as a bound that is another field: each names the C++ field it checks
+// ("VisibilityOptions::fallback_view_angle_deg"), never a config key (the config layer maps one to
+// the other), and states the allowed values in the problem.
 #ifndef FINECAP_SRC_OPTION_CHECKS_H_
 #define FINECAP_SRC_OPTION_CHECKS_H_
 
@@ -34,11 +35,6 @@ inline void RequireFieldRange(int value, int min, int max, const std::string& fi
   Require(value >= min && value <= max, field,
           "is " + std::to_string(value) + " but must lie in [" + std::to_string(min) + ", " +
               std::to_string(max) + "]");
-}
-
-// Throws Error(field, ...) unless `value` is finite (for fields of any value).
-inline void RequireFieldFinite(double value, const std::string& field) {
-  Require(std::isfinite(value), field, "must be a finite number");
 }
 
 // Throws Error(field, ...) unless `value` is one of its enum's choices (not a cast from a wrong

@@ -10,10 +10,12 @@
 
 #include <functional>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "finecap/util/enum_names.h"
+#include "finecap/util/option_fields.h"
 
 namespace YAML {
 class Node;
@@ -52,6 +54,26 @@ class ConfigSchema {
   void AddDoubleList(const std::string& path, std::vector<double>* field, const std::string& doc,
                      double min = std::numeric_limits<double>::lowest(),
                      double max = std::numeric_limits<double>::max());
+
+  // Makes the key of a declared field that needs handling of its own (a custom field, a length
+  // that may be "auto"), from the key's full path and the field's declaration.
+  using FieldKeyMaker = std::function<void(const std::string& path, const OptionField& field)>;
+  // A key for every field that `fields` declares of `*object`, in declaration order, at `prefix`
+  // followed by the field's name ("energy." + "w_reg"; a section's fields below its name), with
+  // the declared doc and range. `special` makes the keys of the fields it names (relative to
+  // `prefix`, e.g. "consensus.passes") instead; it must name every custom field and no field
+  // that is not declared.
+  template <typename Options>
+  void AddFields(const std::string& prefix, Options* object, const OptionFields<Options>& fields,
+                 const std::map<std::string, FieldKeyMaker>& special = {}) {
+    AddFieldKeys(
+        prefix, [object, &fields](OptionFieldVisitor* visitor) { fields.Visit(object, visitor); },
+        special);
+  }
+
+  // An int key bound to `*field` (the config's own copy of a library field) with the range and doc
+  // that `declared` states.
+  void AddDeclaredInt(const std::string& path, int* field, const OptionField& declared);
 
   // A key of any other type: `assign` parses and checks a YAML value and writes the field,
   // throwing Error(where, problem) on failure; `current_text` prints the field as YAML.
@@ -95,6 +117,8 @@ class ConfigSchema {
   std::string MarkdownTable() const;
 
  private:
+  class FieldKeyAdder;
+
   struct Key {
     std::string path;
     std::string type;   // "int", "float", "bool", "string", "choice", "list of float".
@@ -124,6 +148,9 @@ class ConfigSchema {
                     const std::vector<std::string>& choices,
                     std::function<void(const std::string&)> set,
                     std::function<std::string()> current_text);
+  void AddFieldKeys(const std::string& prefix,
+                    const std::function<void(OptionFieldVisitor*)>& visit_fields,
+                    const std::map<std::string, FieldKeyMaker>& special);
   const Key* Find(const std::string& path) const;
   void ReadMapping(const YAML::Node& mapping, const std::string& prefix, const std::string& file);
 

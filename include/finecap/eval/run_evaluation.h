@@ -17,6 +17,7 @@
 #include "finecap/measure/heldout_score.h"
 #include "finecap/refine/refine.h"
 #include "finecap/refine/run_folder.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -24,10 +25,11 @@ struct RunEvaluationOptions {
   // What the run was refined with: its subdivision fixes the fine mesh, its visibility the
   // texture the flow renders; its lengths should be resolved as they were (scene_scale.h).
   RefineOptions refine;
-  // The frame whose images texture the model the flow renders (model.reference_frame). Default 0.
+  // The frame whose images texture the model the flow renders; its range is
+  // SequenceOptions::reference_frame's.
   int reference_frame = 0;
-  // The camera whose view the per-frame pictures show, an index into the capture's cameras.
-  // Default 0.
+  // An index into the capture's cameras, documented where Fields() declares it
+  // (docs/configuration.md: eval.camera).
   int camera = 0;
   // Measure the optical-flow figures; without, they are NaN (null in metrics.json). Default true.
   bool measure_flow = true;
@@ -39,6 +41,7 @@ struct RunEvaluationOptions {
   std::vector<std::string> held_out_cameras;
   HeldOutOptions held_out_score;
 
+  static const OptionFields<RunEvaluationOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include "finecap/geometry/mesh.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -20,22 +21,22 @@ namespace finecap {
 // mean of its neighbours minus the vertex) that lies along its current normal; an iteration is a
 // step with `lambda` (shrinks) followed by one with `mu` (negative: inflates back). Detail whose
 // wavelength spans a few edges is damped by a constant factor per iteration, while shapes much
-// larger than an edge pass almost unchanged (for lambda + mu < 0).
+// larger than an edge pass almost unchanged (for lambda + mu < 0). The fields are documented
+// where Fields() declares them (docs/configuration.md: synth.smoothing); the comments below add
+// what the documentation does not say.
 struct TaubinSmoothingOptions {
-  // Iterations (a lambda step and a mu step each), >= 1: the strength of the smoothing. On a
-  // regular grid, a wave spanning w edges is damped per iteration by about
+  // On a regular grid, a wave spanning w edges is damped per iteration by about
   // (1 - lambda k)(1 - mu k) with k = 1 - cos(2 pi / w): with the defaults 0.75 for w = 4, 0.94
   // for w = 6, 0.98 for w = 8 and 0.997 for w = 13, while waves with k below Taubin's pass band
-  // 1 / lambda + 1 / mu (0.01: w > 44) keep their size. Default 30.
+  // 1 / lambda + 1 / mu (0.01: w > 44) keep their size.
   int iterations = 30;
-  // Step factor of the shrinking step, in (0, 1]. Default 0.5.
   double lambda = 0.5;
-  // Step factor of the inflating step, in [-1, 0]: slightly larger in magnitude than lambda, so
-  // that the pass band is small (0.01) and the largest shapes neither shrink nor grow (0 gives
-  // plain Laplacian smoothing, which shrinks; Taubin's -0.53 with lambda 0.5 grows a tube of 48
-  // edges around by 0.15 % in 20 iterations). Default -0.5025.
+  // -0.5025 makes the pass band small (0.01), and the largest shapes neither shrink nor grow (0
+  // gives plain Laplacian smoothing, which shrinks; Taubin's -0.53 with lambda 0.5 grows a tube
+  // of 48 edges around by 0.15 % in 20 iterations).
   double mu = -0.5025;
 
+  static const OptionFields<TaubinSmoothingOptions>& Fields();  // option_fields.h
   // Throws Error naming `where` + ".iterations", ".lambda" or ".mu" for a value out of range, or
   // a lambda and mu that together make the filter unstable (some detail would grow instead of
   // fading: (1 - 2 lambda)(1 - 2 mu) < -1).

@@ -24,42 +24,39 @@
 
 #include "finecap/geometry/camera.h"
 #include "finecap/geometry/mesh.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
+// How images are rendered. The fields are documented where Fields() declares them
+// (docs/configuration.md: synth.render); the comments below add what the documentation does not
+// say.
 struct RenderOptions {
-  // Samples per pixel along each axis: a colour pixel is the mean of s*s samples (anti-aliasing).
-  // 1 samples the pixel centre only. Ignored by RenderDepth, which always samples pixel centres.
-  // Default 2.
+  // A colour pixel is the mean of s*s samples; 1 samples the pixel centre only. Ignored by
+  // RenderDepth, which always samples pixel centres.
   int supersampling = 2;
 
-  // Skip triangles whose front side (counter-clockwise corners, see mesh.h) faces away from the
-  // camera. Off by default: an open surface such as a skirt shows its inside through its hem.
+  // The front side has counter-clockwise corners (mesh.h). Off: an open surface such as a skirt
+  // shows its inside through its hem.
   bool cull_back_faces = false;
 
-  // Camera z of the near clipping plane, metres (> 0). Default 0.01.
   double near_plane = 0.01;
 
-  // Lambertian shading: colour * (ambient + diffuse * max(0, n . l)), n the interpolated vertex
-  // normal turned towards the camera (so the inside of an open surface is lit like its outside)
-  // and l the unit direction towards the light. Off by default: the colour is the albedo.
+  // n is the interpolated vertex normal turned towards the camera (so the inside of an open
+  // surface is lit like its outside), l the unit direction towards the light. Off: the colour is
+  // the albedo.
   bool shade = false;
-  // Ambient term of the shading, >= 0. Default 0.35.
   double ambient = 0.35;
-  // Diffuse term of the shading, >= 0. Default 0.65.
   double diffuse = 0.65;
-  // Direction from the surface towards the (directional) light in world coordinates; need not be
-  // unit length but must not be zero. Default (0.3, 1, -0.5): from above, slightly in front.
+  // A directional light; (0.3, 1, -0.5) is from above, slightly in front.
   Eigen::Vector3d light_direction = Eigen::Vector3d(0.3, 1.0, -0.5);
 
-  // Colour of pixels that see no surface, RGB in [0, 1]. Default black.
   Eigen::Vector3d background = Eigen::Vector3d::Zero();
 
-  // Standard deviation of additive Gaussian sensor noise, in 8-bit grey levels (>= 0). Default 0.
   double noise_sigma = 0.0;
-  // Seed of the sensor noise: the same seed gives the same noise. Default 0.
-  std::uint64_t noise_seed = 0;
+  std::uint64_t noise_seed = 0;  // The same seed gives the same noise.
 
+  static const OptionFields<RenderOptions>& Fields();  // option_fields.h
   // Throws Error naming the offending field when a value is out of range.
   void Check() const;
 };

@@ -42,23 +42,22 @@
 
 #include "finecap/geometry/camera.h"
 #include "finecap/geometry/mesh.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
+// The held-out score's options. The fields are documented where Fields() declares them
+// (docs/configuration.md: validation).
 struct HeldOutOptions {
-  // Training views warped into each held-out view: the nearest by camera centre. Default 4.
   int neighbours = 4;
-  // Side of the NCC window, pixels, odd. Default 7.
-  int window = 7;
-  // Held-out windows whose grey levels vary less than this (standard deviation, 0-255) are not
-  // scored by NCC. Default 2.
+  int window = 7;  // Odd: a window has a centre pixel.
   double min_std = 2.0;
-  // A surface point counts as seen by a training view when its depth there exceeds that view's
-  // rendered depth by at most this many pixel footprints (depth / focal), at the nearest pixel:
-  // scale-free, and wide enough for surfaces seen at up to ~70 degrees. Default 3.
+  // A pixel footprint is depth / focal, at the nearest pixel: scale-free, and wide enough for
+  // surfaces seen at up to ~70 degrees.
   double depth_tolerance_px = 3.0;
 
-  // Throws Error naming the validation.* key of a value out of range.
+  static const OptionFields<HeldOutOptions>& Fields();  // option_fields.h
+  // Throws Error naming the field (HeldOutOptions::window) of a value out of range.
   void Check() const;
 };
 

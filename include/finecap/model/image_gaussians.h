@@ -43,37 +43,35 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/geometry/color.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
-// How images are cut into image Gaussians.
+// How images are cut into image Gaussians. The fields are documented where Fields() declares them
+// (docs/configuration.md: image_gaussians); the comments below add what the documentation does
+// not say.
 struct ImageGaussianOptions {
-  // Space in which colours are averaged and compared (finecap/geometry/color.h). Default: kHsv, the
-  // paper's choice.
-  ColorSpace color_space = ColorSpace::kHsv;
+  ColorSpace color_space = ColorSpace::kHsv;  // finecap/geometry/color.h
 
-  // Greatest number of times a root square is split; leaves have side RootSide() / 2^depth for a
-  // depth in [0, max_depth]. In [0, 16]. Default: 8, the paper's value.
+  // Leaves have side RootSide() / 2^depth for a depth in [0, max_depth].
   int max_depth = 8;
 
   // The largest RootSide(), and the largest min_leaf_size, pixels.
   static constexpr int kMaxRootSide = 1 << 20;
   static constexpr int kMaxMinLeafSize = 1024;
 
-  // Side of the smallest leaf, pixels; its Gaussian has sigma min_leaf_size / 2. In
-  // [1, kMaxMinLeafSize], and RootSide() may not exceed kMaxRootSide. Default: 4 (sigma 2 px, about
-  // the projected size of the paper's 7 mm surface Gaussians at 2-3 m with a focal length of ~1000
-  // px).
+  // RootSide() may not exceed kMaxRootSide. 4: sigma 2 px, about the projected size of the
+  // paper's 7 mm surface Gaussians at 2-3 m with a focal length of ~1000 px.
   int min_leaf_size = 4;
 
-  // Largest colour spread (RMS colour distance to the mean, units of ColorDistance) a leaf may
-  // have. In [0, 10]. Default: 0.025, half the paper's colour cut-off D = 0.05, so that the
+  // In units of ColorDistance. 0.025: half the paper's colour cut-off D = 0.05, so that the
   // typical pixel of a leaf lies well inside the range in which colours still count as similar.
   double split_threshold = 0.025;
 
   // Side of a root square, pixels: min_leaf_size * 2^max_depth.
   int RootSide() const { return min_leaf_size << max_depth; }
 
+  static const OptionFields<ImageGaussianOptions>& Fields();  // option_fields.h
   // Throws Error naming the field when a value is out of range.
   void Check() const;
 };

@@ -11,32 +11,30 @@
 #include <opencv2/core.hpp>
 
 #include "finecap/geometry/camera.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
+// Which cameras see a point. The fields are documented where Fields() declares them
+// (docs/configuration.md: visibility); the comments below add what the documentation does not say.
 struct VisibilityOptions {
-  // A point is occluded when it lies more than this behind the rendered surface, metres.
-  // Default 0.01: the input mesh is coarse, folds move the true surface by up to ~2 cm. A
-  // refinement makes it follow from the scene unless set (RefineOptions::scene_lengths).
+  // 0.01: the input mesh is coarse, folds move the true surface by up to ~2 cm. A refinement
+  // makes it follow from the scene unless set (RefineOptions::scene_lengths).
   double depth_tolerance = 0.01;
-  // Largest angle between the normal and the direction to the camera, degrees; beyond it the
-  // point is back-facing or seen so obliquely that folds hide parts of it and a small k moves its
-  // projection far. Default 60, for the consensus similarity, which needs two cameras that see
-  // a patch: with a ring of 8 cameras 45 degrees apart, 35 degrees left 87 % of synth_skirt's
-  // Gaussians with fewer than two. surface_color, which needs one, peaks closer to the truth with
-  // 35 (skirt: 0.77 at 75, 0.95 at 35; configs/surface_color.yaml).
+  // Beyond it the point is back-facing or seen so obliquely that folds hide parts of it and a
+  // small k moves its projection far. 60 for the consensus similarity, which needs two cameras
+  // that see a patch: with a ring of 8 cameras 45 degrees apart, 35 degrees left 87 % of
+  // synth_skirt's Gaussians with fewer than two. surface_color, which needs one, peaks closer to
+  // the truth with 35 (skirt: 0.77 at 75, 0.95 at 35; configs/surface_color.yaml).
   double max_view_angle_deg = 60.0;
-  // Largest angle at which a camera still counts for a point that too few cameras see within
-  // max_view_angle_deg, degrees (ComputeFrameVisibility's `wanted`): such a point takes the most
-  // frontal of those that see it within this angle until it has enough. On a sparse rig most of
-  // the surface faces one camera and lies between two others (four cameras 90 degrees apart:
-  // 79 % of synth_skirt's vertices have one camera within 60 degrees). Evidence from steep views
-  // is weaker, and the view confidence (ViewConfidence) says how much weaker. Equal to
-  // max_view_angle_deg: no point takes a camera beyond that. Default 85.
+  // ComputeFrameVisibility's `wanted` cameras. On a sparse rig most of the surface faces one
+  // camera and lies between two others (four cameras 90 degrees apart: 79 % of synth_skirt's
+  // vertices have one camera within 60 degrees). Evidence from steep views is weaker, and the
+  // view confidence (ViewConfidence) says how much weaker. At least max_view_angle_deg.
   double fallback_view_angle_deg = 85.0;
-  // Points projecting closer than this to the image border are not used, pixels. Default 2.
   double border_margin = 2.0;
 
+  static const OptionFields<VisibilityOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 

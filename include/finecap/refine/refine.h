@@ -27,6 +27,7 @@
 #include "finecap/solvers/solver.h"
 #include "finecap/solvers/sweep.h"
 #include "finecap/util/enum_names.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -48,12 +49,13 @@ inline ImageGaussianOptions RefinementImageOptions() {
 // scale^level), each level starting where the coarser one ended. A wider Gaussian reaches a fold
 // further from the input surface before the fine level sharpens it; the paper names such local
 // maxima as its main limitation. The reference colours are the configured level's throughout.
+// The fields are documented where Fields() declares them (docs/configuration.md:
+// refine.coarse_to_fine).
 struct CoarseToFineOptions {
-  // Levels, the configured one included; 1 turns the schedule off. Default 1.
-  int levels = 1;
-  // Factor from one level to the next coarser one. Default 2.
+  int levels = 1;  // The configured level included.
   double scale = 2.0;
 
+  static const OptionFields<CoarseToFineOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
@@ -69,33 +71,25 @@ struct SceneLengths {
   bool max_step = true;         // solver.max_step.
 };
 
+// The options of refining a frame. Its own fields are documented where ModelFields() and
+// RunFields() declare them (docs/configuration.md: model, refine); the comments below add what the
+// documentation does not say.
 struct RefineOptions {
-  // Subdivision levels applied to the coarse mesh before refinement (the paper subdivided its
-  // 1.5k-2.5k-vertex meshes to 6k-10k vertices with Loop's scheme: 1 level). Default 1.
+  // The paper subdivided its 1.5k-2.5k-vertex meshes to 6k-10k vertices with Loop's scheme: 1
+  // level.
   int subdivision_levels = 1;
-  // The scheme of that subdivision (subdivision.h): kLoop smooths the input's own vertices onto
-  // its limit surface; kButterfly keeps them where they are and places only the new vertices.
-  // Default kLoop.
-  SubdivisionScheme subdivision = SubdivisionScheme::kLoop;
-  // Standard deviation sigma_hat of every surface Gaussian, metres. Paper: 0.007. Follows from
-  // the scene unless set (scene_lengths).
-  double sigma_hat = 0.007;
-  // How the reference frame colours the surface Gaussians: kPixels (the paper: the mean of the
-  // pixels under the projected Gaussian in the best-aligned camera) or kImageModel (in that
-  // camera, what the energy's image model shows there; see ComputeModelReferenceColors).
-  // Default kImageModel (the paper: kPixels).
+  SubdivisionScheme subdivision = SubdivisionScheme::kLoop;  // subdivision.h
+  double sigma_hat = 0.007;  // Follows from the scene unless set (scene_lengths).
+  // kPixels: the mean of the pixels under the projected Gaussian in the best-aligned camera;
+  // kImageModel: see ComputeModelReferenceColors.
   ReferenceColorSource reference_colors = ReferenceColorSource::kImageModel;
-  // After solving, add sigma_hat along the normal to every refined vertex, compensating the
-  // slight shrink the Gaussians' extent causes (the paper's section 6). Default false: the
-  // surface-colour similarity has no such shrink (configs/paper.yaml turns it on).
+  // The shrink is the Gaussians' extent's (the paper's section 6). Off: the surface-colour
+  // similarity has no such shrink (configs/paper.yaml turns it on).
   bool bias_compensation = false;
-  // When the solver ends with a lower energy than it started from (the run's own measure says
-  // the frame got worse), write the input surface for that frame instead; `finecap refine` does
-  // the same when the held-out NCC (validation.cameras) of the result is below the input's. The
-  // stats record flags such frames either way. Default false.
+  // Also when the solver ends with a lower energy than it started from: the run's own measure
+  // says the frame got worse. The stats record flags such frames either way.
   bool keep_input_if_worse = false;
-  // Start each frame from the previous frame's k instead of from zero. Default false.
-  bool warm_start = false;
+  bool warm_start = false;  // From the previous frame's k instead of from zero.
 
   // A plane-sweep search for each Gaussian's starting displacement (sweep.h).
   SweepOptions sweep;
@@ -114,6 +108,10 @@ struct RefineOptions {
   // The lengths above that are still to follow from the scene.
   SceneLengths scene_lengths;
 
+  // The fields of the surface model (config section `model`), and those of the run (section
+  // `refine`, with coarse_to_fine and sweep): option_fields.h.
+  static const OptionFields<RefineOptions>& ModelFields();
+  static const OptionFields<RefineOptions>& RunFields();
   void Check() const;
 };
 

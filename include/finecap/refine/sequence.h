@@ -26,6 +26,7 @@
 #include "finecap/refine/refine.h"
 #include "finecap/refine/run_folder.h"
 #include "finecap/util/enum_names.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -38,29 +39,25 @@ const std::vector<EnumName<ReferenceSurface>>& EnumNames(ReferenceSurface);
 
 // How the colours that surface_color and paper compare with the images are taken and kept over a
 // sequence. The consensus similarity uses no such colours, and under it these options do nothing
-// (the colours are then taken at the coarse surface, for the figures that need some).
+// (the colours are then taken at the coarse surface, for the figures that need some). The fields
+// are documented where Fields() declares them (docs/configuration.md: model); the comments below
+// add what the documentation does not say.
 struct ReferenceColorOptions {
-  // With kRefined, the reference frame is first refined with the consensus similarity and
-  // finecap's defaults for everything that a similarity tunes (ReferencePassOptions), and the
-  // colours are taken at that refined surface: at a coarse surface they belong to the wrong
-  // surface points wherever the surface has detail the input lacks. Default kRefined.
+  // kRefined refines the reference frame with finecap's defaults for everything that a
+  // similarity tunes (ReferencePassOptions): at a coarse surface the colours belong to the wrong
+  // surface points wherever the surface has detail the input lacks.
   ReferenceSurface reference_surface = ReferenceSurface::kRefined;
-  // Rate r at which the colours follow the sequence, in [0, 1]; 0 (default) keeps the reference
-  // colours for every frame (the paper). After each refined frame from the reference frame on
-  // that the run did not flag worse, every colour its refined surface shows (where a camera saw
-  // the vertex) is blended in, eta <- eta + r (eta_frame - eta), so slow changes of lighting or
-  // appearance are followed. Following is sequential: frame t uses the colours that frame t - 1
-  // left, saved in the run folder (so a resumed run continues exactly), and a frame whose
-  // predecessor is not done there is refused.
+  // Rate r: every colour a refined frame's surface shows (where a camera saw the vertex) is
+  // blended in, eta <- eta + r (eta_frame - eta). Frame t uses the colours that frame t - 1 left,
+  // saved in the run folder (so a resumed run continues exactly), and a frame whose predecessor
+  // is not done there is refused.
   double follow_colors = 0.0;
-  // Pull of every followed colour back towards its reference colour after each update,
-  // eta <- eta + a (eta_reference - eta), in [0, 1]: what keeps the errors of one frame's surface
-  // from accumulating frame after frame (drift). A steady change of the images is followed to
-  // the share r (1 - a) / (r + a - r a) of it; the reference colour remains the anchor.
-  // Default 0.1.
+  // Anchor a: eta <- eta + a (eta_reference - eta) after each update. A steady change of the
+  // images is followed to the share r (1 - a) / (r + a - r a) of it.
   double follow_anchor = 0.1;
 
   bool following() const { return follow_colors > 0.0; }
+  static const OptionFields<ReferenceColorOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
@@ -68,8 +65,9 @@ struct SequenceOptions {
   // How each frame is refined. Its lengths should be resolved from the scene first
   // (ResolveSceneScaleDefaults, scene_scale.h).
   RefineOptions refine;
-  // The frame whose images colour the surface Gaussians of every frame (model.reference_frame).
-  // Default 0.
+  // The frame whose images colour the surface Gaussians of every frame. Its documentation and
+  // max_memory_mb's are where Fields() declares them (docs/configuration.md: model.reference_frame,
+  // runtime.max_memory_mb).
   int reference_frame = 0;
   // How the colours are taken and kept over the sequence.
   ReferenceColorOptions colors;
@@ -83,11 +81,11 @@ struct SequenceOptions {
   bool skip_unreadable_cameras = false;
   // How the refined meshes are written. Default PLY.
   MeshFormat mesh_format = MeshFormat::kPly;
-  // A run whose forecast peak memory (EstimateProblemSize) exceeds this many megabytes, or the
-  // memory available to the process (ReadAvailableMemory), is refused before it reads more than
-  // its first frame or writes anything. 0: only the memory available. Default 0.
+  // The forecast is EstimateProblemSize's, the memory available ReadAvailableMemory's. A run is
+  // refused before it reads more than its first frame or writes anything.
   int max_memory_mb = 0;
 
+  static const OptionFields<SequenceOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 

@@ -24,6 +24,7 @@
 
 #include "finecap/energy/frame_energy.h"
 #include "finecap/util/enum_names.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -46,43 +47,39 @@ const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType);
 enum class CurvatureModel { kGaussNewton, kSecant };
 const std::vector<EnumName<CurvatureModel>>& EnumNames(CurvatureModel);
 
+// The solver's options. The fields but num_threads are documented where Fields() declares them
+// (docs/configuration.md: solver); the comments below add what the documentation does not say.
 struct SolverOptions {
   SolverType type = SolverType::kCeres;
-  // Most iterations. Paper (gradient ascent): 150.
   int max_iterations = 50;
-  // Stop when the energy changes by less than this fraction of its value. Default 1e-3: on
-  // synth_skirt, Ceres reaches within 0.01 mm of its 1e-6 result in 5 iterations instead of 32.
-  // Ceres counts only the steps it takes: a rejected step's change says nothing of convergence.
+  // 1e-3: on synth_skirt, Ceres reaches within 0.01 mm of its 1e-6 result in 5 iterations
+  // instead of 32. Ceres counts only the steps it takes: a rejected step's change says nothing of
+  // convergence.
   double function_tolerance = 1e-3;
-  // Threads of Ceres' evaluation and linear algebra; 0 = all cores.
+  // Threads of Ceres' evaluation and linear algebra; 0 = all cores (the config's runtime.threads).
   int num_threads = 0;
   // num_threads, with 0 resolved to the machine's cores (at least one).
   int Threads() const;
 
-  // Ceres only: trust-region strategy.
   TrustRegionType trust_region = TrustRegionType::kLevenbergMarquardt;
-  // Ceres only: the linear solver. Conjugate gradients by default: the normal equations are
-  // diagonal but for the regulariser, so a few products solve them to the accuracy the step
-  // needs, at a fifth of the time of SuiteSparse's factorisation on synth_skirt and to the same
-  // error on every capture measured (docs/measurements.md, "Where a frame's time goes").
+  // Conjugate gradients: the normal equations are diagonal but for the regulariser, so a few
+  // products solve them to the accuracy the step needs, at a fifth of the time of SuiteSparse's
+  // factorisation on synth_skirt and to the same error on every capture measured
+  // (docs/measurements.md, "Where a frame's time goes").
   LinearSolverType linear_solver = LinearSolverType::kCgnr;
-  // Ceres only: the curvature of the similarity's model. Default secant: the consensus energy
-  // curves less than J^T J says (Ceres' steps gained 1.2-1.6 times what the model predicted), and
-  // with the secant Ceres ends nearer the energy's optimum for the same evaluations
-  // (docs/method.md, "Solvers").
+  // Secant: the consensus energy curves less than J^T J says (Ceres' steps gained 1.2-1.6 times
+  // what the model predicted), and with the secant Ceres ends nearer the energy's optimum for the
+  // same evaluations (docs/method.md, "Solvers").
   CurvatureModel curvature = CurvatureModel::kSecant;
 
-  // Gradient ascent only: the first step of the largest-gradient k_s, metres (the step factors
-  // are scaled from it). Default 0.5 mm; a refinement makes it follow from the scene unless set
+  // The step factors are scaled from it. A refinement makes it follow from the scene unless set
   // (RefineOptions::scene_lengths), as max_step.
   double initial_step = 0.0005;
-  // Gradient ascent only: step factor growth when a derivative keeps its sign, and shrink when
-  // it flips. Defaults 1.2 and 0.5.
   double step_growth = 1.2;
   double step_shrink = 0.5;
-  // Gradient ascent only: the largest step of one k_s in one iteration, metres. Default 2 mm.
   double max_step = 0.002;
 
+  static const OptionFields<SolverOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 

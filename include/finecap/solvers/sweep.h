@@ -11,22 +11,26 @@
 #include <Eigen/Core>
 
 #include "finecap/energy/frame_energy.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
+// The plane sweep's options. The fields are documented where Fields() declares them
+// (docs/configuration.md: refine.sweep); the comments below add what the documentation does not
+// say.
 struct SweepOptions {
-  // The bounds of `samples` when the sweep is on.
+  // The bounds of `samples` when the sweep is on: fewer than 3 displacements would not include
+  // k = 0 and both signs.
   static constexpr int kMinSamples = 3;
   static constexpr int kMaxSamples = 1000;
 
-  // Number of displacements tried in [-k_max, k_max]: 0 (off) or in [kMinSamples, kMaxSamples].
-  // Default 33: with the
-  // consensus similarity's tabulated colours a sample costs little, and a start from the best
-  // displacement of each patch reaches inputs farther from the truth (the temple's visual hull).
+  // Displacements in [-k_max, k_max]. 33: with the consensus similarity's tabulated colours a
+  // sample costs little, and a start from the best displacement of each patch reaches inputs
+  // farther from the truth (the temple's visual hull).
   int samples = 33;
-  // Rounds of averaging each Gaussian's cost curve with its neighbours'. Default 4.
   int smoothing_rounds = 4;
 
+  static const OptionFields<SweepOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 

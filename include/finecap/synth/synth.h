@@ -35,6 +35,7 @@
 #include "finecap/geometry/mesh_smoothing.h"
 #include "finecap/geometry/render.h"
 #include "finecap/util/enum_names.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 
@@ -51,53 +52,44 @@ namespace finecap {
 enum class FoldProfile { kSine, kRidge };
 const std::vector<EnumName<FoldProfile>>& EnumNames(FoldProfile);
 
+// A family of folds. The fields are documented where Fields() declares them (docs/configuration.md:
+// synth.folds); the comments below add what the documentation does not say.
 struct FoldComponent {
-  // Peak displacement along the outward normal, metres; a negative value flips the folds.
-  // Typical 0.002 to 0.02. Default 0.008.
+  // Along the outward normal; a negative value flips the folds. Typical 0.002 to 0.02.
   double amplitude = 0.008;
-  // Distance between neighbouring crests, metres (0.01 to 1). Default 0.12.
-  double wavelength = 0.12;
-  // Direction of the crests, degrees: 0 = crests run down the subject (waves travel around it,
-  // like the folds of a hanging skirt); 90 = crests run around it. Default 0.
+  double wavelength = 0.12;  // Between neighbouring crests.
+  // 0: waves travel around the subject, like the folds of a hanging skirt; 90: crests run around
+  // it.
   double orientation = 0.0;
-  // Phase at frame 0, degrees. Default 0.
-  double phase = 0.0;
-  // Phase change per frame, degrees: the folds drift over the surface. Default 6.
-  double drift = 6.0;
-  // Cross-section of a fold: kSine, or kRidge (sharp crests and broad troughs, zero mean,
-  // 4/pi * amplitude high and 2 - 4/pi below). Default kSine.
+  double phase = 0.0;  // At frame 0.
+  double drift = 6.0;  // The folds drift over the surface.
+  // kRidge: sharp crests and broad troughs, zero mean, 4/pi * amplitude high and 2 - 4/pi below.
   FoldProfile profile = FoldProfile::kSine;
 
+  static const OptionFields<FoldComponent>& Fields();  // option_fields.h
   // Throws Error naming `where` and the field when a value is out of range.
   void Check(const std::string& where) const;
 };
 
 // The built-in subject: a skirt-like flared tube, open at both ends (the paper's hardest case).
+// The fields are documented where Fields() declares them (docs/configuration.md: synth.skirt);
+// the comments below add what the documentation does not say.
 struct SkirtOptions {
-  // Radius at the waist (top), metres. Default 0.14.
   double waist_radius = 0.14;
-  // Radius at the hem (bottom), metres, >= waist_radius. Default 0.36.
   double hem_radius = 0.36;
-  // Height from waist to hem, metres. Default 0.6.
   double length = 0.6;
-  // Shape of the flare: radius grows like s^flare_exponent from waist (s = 0) to hem (s = 1);
-  // 1 is a cone, larger values flare late. Default 1.4.
-  double flare_exponent = 1.4;
-  // Height of the waist above the floor (world y), metres. Default 1.0.
+  double flare_exponent = 1.4;  // Larger values flare late.
   double waist_height = 1.0;
-  // Coarse mesh resolution: vertices around the tube and from waist to hem (>= 8 and >= 3).
-  // Defaults 64 and 40 (2560 vertices, ~4 cm apart at the hem).
+  // 64 x 40: 2560 vertices, ~4 cm apart at the hem.
   int around = 64;
   int down = 40;
-  // Low-frequency motion, one cycle every `period` frames: the hem sways sideways by up to
-  // `sway` metres, twists about the vertical axis by up to `swing` degrees, and its outline
-  // wobbles into an ellipse whose radii differ by up to `flare_wobble` (a fraction) from round.
-  // Defaults 0.05 m, 10 degrees, 0.08, 30 frames.
+  // The hem's outline wobbles into an ellipse (flare_wobble).
   double sway = 0.05;
   double swing = 10.0;
   double flare_wobble = 0.08;
   double period = 30.0;
 
+  static const OptionFields<SkirtOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
@@ -106,50 +98,45 @@ struct SkirtOptions {
 enum class TexturePattern { kMixed, kPlaid, kStripes, kPrint, kNoise };
 const std::vector<EnumName<TexturePattern>>& EnumNames(TexturePattern);
 
-// The procedural cloth print, generated in texture (u, v) space.
+// The procedural cloth print, generated in texture (u, v) space. The fields are documented where
+// Fields() declares them (docs/configuration.md: synth.texture).
 struct TextureOptions {
-  // Texture image size in texels. Defaults 2048 x 1024.
   int width = 2048;
   int height = 1024;
-  // The print. Default kMixed.
   TexturePattern pattern = TexturePattern::kMixed;
-  // A band of the surface painted in one plain colour: from textureless_begin to textureless_end,
-  // as fractions of the subject's height measured from its top (0 to 1). No band when they are
-  // equal. Defaults 0 and 0.
+  // textureless_end is at least textureless_begin.
   double textureless_begin = 0.0;
   double textureless_end = 0.0;
-  // Colour of that band, RGB in [0, 1]. Default (0.62, 0.55, 0.48).
   Eigen::Vector3d textureless_color = Eigen::Vector3d(0.62, 0.55, 0.48);
 
+  static const OptionFields<TextureOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
 // The camera rig: `count` cameras evenly spaced on a ring around the subject's vertical axis,
-// each looking at the subject's centre.
+// each looking at the subject's centre. The fields are documented where Fields() declares them
+// (docs/configuration.md: synth.cameras); the comments below add what the documentation does not
+// say.
 struct RigOptions {
-  // Number of cameras (>= 1). Default 8.
   int count = 8;
-  // Image size in pixels. Defaults 1004 x 1004 (the paper's studio).
+  // 1004 x 1004: the paper's studio.
   int width = 1004;
   int height = 1004;
-  // Focal length in pixels. Default 1000: at the default distance of 3 m a surface Gaussian of
-  // 7 mm spans 2.3 pixels, as in the paper's studio.
+  // 1000: at the default distance of 3 m a surface Gaussian of 7 mm spans 2.3 pixels, as in the
+  // paper's studio.
   double focal = 1000.0;
-  // Horizontal distance from the subject's axis, metres. Default 3.
   double distance = 3.0;
-  // Heights of the cameras above the subject's centre, metres; camera c uses
-  // heights[c % heights.size()], so two values alternate high and low cameras. Default {0.4, -0.2}.
+  // Two values alternate high and low cameras.
   std::vector<double> heights = {0.4, -0.2};
-  // Lens distortion (k1, k2, p1, p2, k3) of every camera (OpenCV's model): images are rendered
-  // undistorted and then distorted, so undistorting them with cameras.yaml inverts it. Default 0.
+  // Images are rendered undistorted and then distorted, so undistorting them with cameras.yaml
+  // inverts it.
   std::array<double, 5> distortion = {0, 0, 0, 0, 0};
-  // Calibration noise: cameras.yaml states cameras perturbed from the true ones by a random
-  // rotation (standard deviation per axis, degrees), centre offset (per axis, metres) and
-  // relative focal length error. Defaults 0.
+  // cameras.yaml states cameras perturbed from the true ones by these.
   double rotation_noise = 0.0;
   double translation_noise = 0.0;
   double focal_noise = 0.0;
 
+  static const OptionFields<RigOptions>& Fields();  // option_fields.h
   void Check() const;
 };
 
@@ -187,69 +174,55 @@ const std::vector<EnumName<SynthSubject>>& EnumNames(SynthSubject);
 enum class SynthBackground { kPlain, kPerCamera };
 const std::vector<EnumName<SynthBackground>>& EnumNames(SynthBackground);
 
+// The fields are documented where Fields() declares them (docs/configuration.md: synth); the
+// comments below add what the documentation does not say.
 struct SynthOptions {
-  // kSkirt (the built-in flared tube, see `skirt`) or kMesh (the meshes at `mesh_path`).
-  // Default kSkirt.
   SynthSubject subject = SynthSubject::kSkirt;
   SkirtOptions skirt;
-  // For subject "mesh": a mesh file (the subject stands still) or a folder of per-frame meshes
-  // sharing one topology, taken in name order (.ply, .obj, .off, .stl). World y must point up.
-  // The true surface is each frame's midpoint subdivision with folds added along interpolated
-  // normals (truth_refinement 1 and no folds: the mesh itself); the coarse input is the mesh
-  // itself, or its smoothed copy (see `coarse`; exact: the mesh itself). Default empty.
+  // A mesh file: the subject stands still; a folder: taken in name order. The true surface is
+  // each frame's midpoint subdivision with folds added along interpolated normals
+  // (truth_refinement 1 and no folds: the mesh itself); the coarse input is the mesh itself, or
+  // its smoothed copy (see `coarse`; exact: the mesh itself).
   std::string mesh_path;
-  // Number of frames (>= 1; at most the number of meshes in a `mesh_path` folder). Default 5.
   int num_frames = 5;
-  // Resolution of the true surface relative to the coarse mesh, per axis (edges per coarse
-  // edge). Any integer >= 1 for the skirt; a power of two for "mesh" (midpoint subdivision
-  // levels). Default 4.
+  // Per axis. A power of two for "mesh": midpoint subdivision levels.
   int truth_refinement = 4;
 
-  // The folds, summed. Default: three families of 8-20 cm waves in different directions.
+  // Three families of 8-20 cm waves in different directions.
   std::vector<FoldComponent> folds = {
       {0.009, 0.16, 0.0, 0.0, 5.0, FoldProfile::kSine},
       {0.006, 0.10, 25.0, 40.0, -7.0, FoldProfile::kRidge},
       {0.004, 0.20, 70.0, 120.0, 4.0, FoldProfile::kSine},
   };
-  // When > 0, every fold gets this wavelength (metres): captures with one fold scale. Default 0.
+  // Captures with one fold scale.
   double single_wavelength = 0.0;
-  // Fold amplitudes grow smoothly from zero at frame 0 to full at this frame; 0 gives full folds
-  // from frame 0. With a ramp the reference frame (frame 0, whose images colour the surface) has
-  // an exact coarse mesh, which a real capture never has: it flatters the refinement, and is kept
-  // for comparison (configs/synth_skirt_ramp.yaml). Default 0.
+  // With a ramp the reference frame (frame 0, whose images colour the surface) has an exact
+  // coarse mesh, which a real capture never has: it flatters the refinement, and is kept for
+  // comparison (configs/synth_skirt_ramp.yaml).
   int fold_ramp_frames = 0;
 
-  // What the coarse meshes are (see CoarseInput). Default kUnfolded.
   CoarseInput coarse = CoarseInput::kUnfolded;
-  // The smoothing of the coarse meshes when `coarse` is kSmoothed (its iterations are the
-  // strength). Default: 30 iterations, lambda 0.5, mu -0.5025.
-  TaubinSmoothingOptions smoothing;
+  TaubinSmoothingOptions smoothing;  // When `coarse` is kSmoothed.
 
-  // Peak of a smooth random displacement field (3D, fixed to the material) added to the coarse
-  // meshes: the input's low-frequency misalignment, metres. Default 0.
+  // The field is 3D and fixed to the material: the input's low-frequency misalignment.
   double misalignment = 0.0;
-  // Spatial wavelength of that field, metres (> 0). Default 0.5.
   double misalignment_wavelength = 0.5;
-  // Largest |k| searched when casting a coarse vertex's normal against the true surface,
-  // metres (> 0); farther hits are reported as misses. Default 0.1.
+  // When casting a coarse vertex's normal against the true surface.
   double max_displacement = 0.1;
 
   TextureOptions texture;
   RigOptions cameras;
-  // How images are rendered (supersampling, shading, sensor noise, background). The noise seed
-  // of each image is derived from `seed`, the frame and the camera together with
-  // render.noise_seed. Default: supersampling 3, shading on (ambient 0.5, diffuse 0.6),
-  // background dark grey.
+  // The noise seed of each image is derived from `seed`, the frame and the camera together with
+  // render.noise_seed. DefaultRenderOptions: supersampling 3, shading on (ambient 0.5, diffuse
+  // 0.6), background dark grey.
   RenderOptions render = DefaultRenderOptions();
-  // The background of the images (see SynthBackground). Default kPlain.
   SynthBackground background = SynthBackground::kPlain;
-  // Whether GenerateSyntheticCapture writes the foreground masks (masks/). Default false.
-  bool write_masks = false;
+  bool write_masks = false;  // masks/, by GenerateSyntheticCapture.
 
-  // Seed of every random choice (texture, misalignment, calibration and sensor noise). Default 1.
   std::uint64_t seed = 1;
 
-  // Throws Error("synth.<field>", problem) for the first invalid value.
+  static const OptionFields<SynthOptions>& Fields();  // option_fields.h
+  // Throws Error("SynthOptions::<field>", problem) for the first invalid value.
   void Check() const;
 
   static RenderOptions DefaultRenderOptions();
