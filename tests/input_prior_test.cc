@@ -181,7 +181,7 @@ TEST(InputPriorEnergyTest, ScalarGradientAndLeastSquaresFormAgree) {
 // Pulls on one unknown are one quadratic: the first is taken as it is, a later one adds its
 // curvature and blends the targets by the curvatures; no curvature or no target adds nothing.
 TEST(PullsTest, TwoPullsOnOneUnknownAreOneQuadratic) {
-  Pulls pulls;
+  Pulls pulls(3);
   EXPECT_EQ(pulls.Evaluate(Eigen::VectorXd::Zero(3)), 0.0);
   pulls.Add(Eigen::Vector3d(2.0, 0.0, 1.0), Eigen::Vector3d(0.1, 0.2, 0.3));
   EXPECT_EQ(pulls.curvature(), Eigen::Vector3d(2.0, 0.0, 1.0));

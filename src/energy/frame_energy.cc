@@ -81,8 +81,7 @@ double FrameEnergy::TypicalDataCurvature() {
 }
 
 void FrameEnergy::GatherPulls() {
-  pulls_ = Pulls();
-  pulls_.Add(Eigen::VectorXd::Zero(surface_.size()), Eigen::VectorXd::Zero(surface_.size()));
+  pulls_ = Pulls(surface_.size());
   for (const auto& term : quadratic_terms_) term->AddPulls(&pulls_);
 }
 

@@ -32,7 +32,6 @@ void Pulls::Add(double curvature, const Eigen::VectorXd& target) {
 }
 
 double Pulls::Evaluate(const Eigen::VectorXd& k) const {
-  if (curvature_.size() == 0) return 0.0;
   const Eigen::VectorXd from_target = k - target_;
   return 0.5 * from_target.dot(curvature_.cwiseProduct(from_target));
 }

@@ -11,6 +11,7 @@
 
 #include "finecap/util/enum_names.h"
 #include "finecap/util/error.h"
+#include "finecap/util/option_fields.h"
 
 namespace finecap {
 namespace internal {
@@ -22,27 +23,20 @@ inline std::string CheckNumberText(double value) {
   return text.str();
 }
 
-// Throws Error(field, ...) unless `value` is finite and in [min, max].
+// Throws Error(field, ...) unless `value` is finite and in [min, max], in the words of a declared
+// field's check (option_fields.h).
 inline void RequireFieldRange(double value, double min, double max, const std::string& field) {
-  Require(std::isfinite(value), field, "must be a finite number");
-  Require(value >= min && value <= max, field,
-          "is " + CheckNumberText(value) + " but must lie in [" + CheckNumberText(min) + ", " +
-              CheckNumberText(max) + "]");
-}
-
-// Throws Error(field, ...) unless min <= value <= max.
-inline void RequireFieldRange(int value, int min, int max, const std::string& field) {
-  Require(value >= min && value <= max, field,
-          "is " + std::to_string(value) + " but must lie in [" + std::to_string(min) + ", " +
-              std::to_string(max) + "]");
+  OptionField range;
+  range.min = min;
+  range.max = max;
+  CheckDeclaredNumber(value, range, field);
 }
 
 // Throws Error(field, ...) unless `value` is one of its enum's choices (not a cast from a wrong
 // integer).
 template <typename Enum>
 void RequireKnownChoice(Enum value, const std::string& field) {
-  Require(IsKnownEnum(value), field,
-          "is not a valid choice (value " + std::to_string(static_cast<int>(value)) + ")");
+  CheckDeclaredChoice(IsKnownEnum(value), static_cast<int>(value), field);
 }
 
 }  // namespace internal

@@ -31,6 +31,11 @@ class Regularizer;
 // solver needs, is dropped).
 class Pulls {
  public:
+  // No pull on any of `num_unknowns` unknowns.
+  explicit Pulls(int num_unknowns = 0)
+      : curvature_(Eigen::VectorXd::Zero(num_unknowns)),
+        target_(Eigen::VectorXd::Zero(num_unknowns)) {}
+
   // Adds 1/2 curvature_s (k_s - target_s)^2 for every s where curvature_s is positive and
   // target_s finite (a term may have no target for an unknown). Where no pull was yet, the new one
   // is taken as it is.
@@ -38,10 +43,10 @@ class Pulls {
   // As Add, with the same curvature for every s.
   void Add(double curvature, const Eigen::VectorXd& target);
 
-  // p_s and t_s (0 where nothing pulls); empty before the first Add.
+  // p_s and t_s (0 where nothing pulls).
   const Eigen::VectorXd& curvature() const { return curvature_; }
   const Eigen::VectorXd& target() const { return target_; }
-  // E_pull at k (0 before the first Add); its gradient is p_s (k_s - t_s).
+  // E_pull at k; its gradient is p_s (k_s - t_s).
   double Evaluate(const Eigen::VectorXd& k) const;
 
  private:
