@@ -5,7 +5,7 @@
 # the refined surface and for the input as given. One "figure: value" a line.
 #
 #   bash bench/flicker.sh
-#   SET="energy.temporal_weight=0" bash bench/flicker.sh     # a variant, the same capture
+#   SET="energy.w_reg=3e-6" bash bench/flicker.sh            # a variant, the same capture
 #   WORK=DIR bash bench/flicker.sh                           # keeps the capture (made once)
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -34,6 +34,9 @@ function(finecap_add_module name)
   file(CREATE_LINK ${PROJECT_SOURCE_DIR}/src/${name} ${internal_root}/${name} SYMBOLIC)
 
   file(GLOB_RECURSE sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/src/${name}/*.cc)
+  # A piece of a module may keep its tests beside it (src/energy/terms/<term>/*_test.cc): they
+  # belong to the tests' executable, not the library.
+  list(FILTER sources EXCLUDE REGEX "_test\\.cc$")
   add_library(finecap_${name} STATIC ${sources})
   target_include_directories(finecap_${name} PUBLIC ${public_root})
   add_library(finecap_${name}_internal INTERFACE)

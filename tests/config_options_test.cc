@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "finecap/config/config.h"
+#include "finecap/energy/term_options.h"
 #include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
 #include "finecap/util/option_fields.h"
@@ -102,25 +103,30 @@ EdgeValues Edges(const ConfigSchema::NumericKey& key) {
 // The declared fields of every options struct the config reads, with the prefix its Check()
 // names them by.
 std::vector<std::pair<std::string, std::vector<OptionField>>> DeclaredFields() {
-  return {{"RefineOptions::", RefineOptions::ModelFields().Declared()},
-          {"RefineOptions::", RefineOptions::RunFields().Declared()},
-          {"ReferenceColorOptions::", ReferenceColorOptions::Fields().Declared()},
-          {"ImageGaussianOptions::", ImageGaussianOptions::Fields().Declared()},
-          {"VisibilityOptions::", VisibilityOptions::Fields().Declared()},
-          {"EnergyOptions::", EnergyOptions::Fields().Declared()},
-          {"ConsensusOptions::", ConsensusOptions::Fields().Declared()},
-          {"SolverOptions::", SolverOptions::Fields().Declared()},
-          {"SweepOptions::", SweepOptions::Fields().Declared()},
-          {"CoarseToFineOptions::", CoarseToFineOptions::Fields().Declared()},
-          {"HeldOutOptions::", HeldOutOptions::Fields().Declared()},
-          {"SynthOptions::", SynthOptions::Fields().Declared()},
-          {"SynthOptions::smoothing.", TaubinSmoothingOptions::Fields().Declared()},
-          {"SkirtOptions::", SkirtOptions::Fields().Declared()},
-          {"TextureOptions::", TextureOptions::Fields().Declared()},
-          {"RigOptions::", RigOptions::Fields().Declared()},
-          {"RenderOptions::", RenderOptions::Fields().Declared()},
-          {"SequenceOptions::", SequenceOptions::Fields().Declared()},
-          {"RunEvaluationOptions::", RunEvaluationOptions::Fields().Declared()}};
+  std::vector<std::pair<std::string, std::vector<OptionField>>> declared = {
+      {"RefineOptions::", RefineOptions::ModelFields().Declared()},
+      {"RefineOptions::", RefineOptions::RunFields().Declared()},
+      {"ReferenceColorOptions::", ReferenceColorOptions::Fields().Declared()},
+      {"ImageGaussianOptions::", ImageGaussianOptions::Fields().Declared()},
+      {"VisibilityOptions::", VisibilityOptions::Fields().Declared()},
+      {"EnergyOptions::", EnergyOptions::Fields().Declared()},
+      {"ConsensusOptions::", ConsensusOptions::Fields().Declared()},
+      {"SolverOptions::", SolverOptions::Fields().Declared()},
+      {"SweepOptions::", SweepOptions::Fields().Declared()},
+      {"CoarseToFineOptions::", CoarseToFineOptions::Fields().Declared()},
+      {"HeldOutOptions::", HeldOutOptions::Fields().Declared()},
+      {"SynthOptions::", SynthOptions::Fields().Declared()},
+      {"SynthOptions::smoothing.", TaubinSmoothingOptions::Fields().Declared()},
+      {"SkirtOptions::", SkirtOptions::Fields().Declared()},
+      {"TextureOptions::", TextureOptions::Fields().Declared()},
+      {"RigOptions::", RigOptions::Fields().Declared()},
+      {"RenderOptions::", RenderOptions::Fields().Declared()},
+      {"SequenceOptions::", SequenceOptions::Fields().Declared()},
+      {"RunEvaluationOptions::", RunEvaluationOptions::Fields().Declared()}};
+  for (const TermOptionSection& term : TermOptionSections()) {
+    declared.push_back({term.field_prefix, term.fields});
+  }
+  return declared;
 }
 
 // A declared bound as the schema states it: an unbounded side of an int is the int's limit.

@@ -203,54 +203,5 @@ TEST(PullsTest, TwoPullsOnOneUnknownAreOneQuadratic) {
   EXPECT_THROW(pulls.Add(1.0, Eigen::VectorXd::Zero(4)), Error);
 }
 
-// The temporal pull (energy.temporal_weight) does nothing until the frame before is known, then
-// joins the prior as one quadratic per k_s: the energy drops by exactly 1/2 w H (k_s - before_s)^2
-// over the finite targets, H the median data curvature, for every k; the least-squares form
-// follows it.
-TEST(TemporalTermTest, TheFrameBeforeJoinsThePriorAsOneQuadratic) {
-  EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 9);
-  const Eigen::VectorXd offsets = RandomK(scene.surface.size(), 0.002, 11);
-  scene.surface.input_offset.assign(offsets.data(), offsets.data() + offsets.size());
-  const FrameEnergy plain(scene.surface, scene.cameras, scene.neighbourhoods,
-                          SurfaceColorOptions(50));
-  EnergyOptions options = SurfaceColorOptions(50);
-  const double weight = 2.0;
-  options.temporal_weight = weight;
-  FrameEnergy pulled(scene.surface, scene.cameras, scene.neighbourhoods, options);
-  const int n = pulled.num_parameters();
-  EXPECT_EQ(pulled.pull_curvature(), plain.pull_curvature());
-  EXPECT_EQ(pulled.pull_target(), plain.pull_target());
-
-  Eigen::VectorXd before = RandomK(n, 0.003, 12);
-  before[1] = std::nan("");  // A vertex the frame before did not refine: not pulled.
-  pulled.TakeFrameBefore(before);
-  const double h = MedianOfPositive(DataCurvature(&pulled.similarity(), Eigen::VectorXd::Zero(n)));
-  ASSERT_GT(h, 0.0);
-  EXPECT_EQ(pulled.pull_curvature()[1], plain.pull_curvature()[1]);
-  EXPECT_EQ(pulled.pull_target()[1], plain.pull_target()[1]);
-  EXPECT_NEAR(pulled.pull_curvature()[0], plain.pull_curvature()[0] + weight * h,
-              1e-12 * pulled.pull_curvature()[0]);
-
-  double constant = std::nan("");
-  for (unsigned seed : {20u, 21u, 22u}) {
-    const Eigen::VectorXd k = RandomK(n, 0.004, seed);
-    double pull = 0.0;
-    for (int s = 0; s < n; ++s) {
-      if (std::isfinite(before[s])) pull += 0.5 * weight * h * std::pow(k[s] - before[s], 2);
-    }
-    const double plain_energy = plain.Evaluate(k, nullptr), energy = pulled.Evaluate(k, nullptr);
-    // The blend of two quadratics is one quadratic plus a constant: the same at every k.
-    const double difference = plain_energy - energy - pull;
-    if (std::isnan(constant)) constant = difference;
-    EXPECT_NEAR(difference, constant, 1e-9 * std::abs(energy));
-    EXPECT_NEAR(LeastSquaresCost(&pulled, k), -energy, 1e-9 * std::abs(energy));
-  }
-  // Taken again, the frame before replaces itself rather than pulling twice.
-  const Eigen::VectorXd curvature = pulled.pull_curvature();
-  pulled.TakeFrameBefore(before);
-  EXPECT_EQ(pulled.pull_curvature(), curvature);
-  EXPECT_THROW(pulled.TakeFrameBefore(Eigen::VectorXd::Zero(n + 1)), Error);
-}
-
 }  // namespace
 }  // namespace finecap

@@ -60,8 +60,7 @@ TEST(RefineSequenceTest, TheFrameAfterAKeptInputStartsWhereAFirstFrameStarts) {
   config.refine.bias_compensation = true;
   config.refine.keep_input_if_worse = true;
   config.refine.warm_start = true;
-  config.refine.energy.temporal_weight = 0.0;  // Its pull would be in frame 1's energy too.
-  config.refine.sweep.samples = 0;             // A frame without a predecessor starts at zero.
+  config.refine.sweep.samples = 0;  // A frame without a predecessor starts at zero.
   ASSERT_EQ(RunRefine(config), 0);
   ASSERT_TRUE(Record(config.output.dir, "000000").kept_input);
 
@@ -129,27 +128,13 @@ class CountingObserver : public SequenceObserver {
   std::vector<std::string> refined;
 };
 
-// A tiny refinable capture of `frames` frames, generated in `root`/capture, opened.
-Capture OpenTinyCapture(const std::string& root, int frames) {
-  GenerateSyntheticCapture(testing_util::TinyRefinableSynthOptions(frames), root + "/capture");
-  return Capture::Open(root + "/capture");
-}
-
-SequenceOptions QuickOptions() {
-  SequenceOptions options;
-  options.refine.solver.max_iterations = 2;
-  options.refine.solver.num_threads = 1;
-  options.refine.sweep.samples = 0;
-  return options;
-}
-
 TEST(RefineSequenceTest, RefinesTheFramesLeftAndReportsThem) {
   const OneWorkerThread one_thread;
   const std::string root = MakeTempDir("sequence_library");
   const SynthOptions synth = testing_util::TinyRefinableSynthOptions(2);
   GenerateSyntheticCapture(synth, root + "/capture");
   Capture capture = Capture::Open(root + "/capture");
-  SequenceOptions options = QuickOptions();
+  SequenceOptions options = testing_util::QuickSequenceOptions();
   options.held_out_cameras = {"cam02"};
   const std::string out = root + "/run";
   fs::create_directories(out);
@@ -188,8 +173,8 @@ TEST(RefineSequenceTest, RefinesTheFramesLeftAndReportsThem) {
 TEST(RefineSequenceTest, FlickerFollowsTheFrameBeforeAcrossResumesAndShards) {
   const OneWorkerThread one_thread;
   const std::string root = MakeTempDir("sequence_flicker");
-  Capture capture = OpenTinyCapture(root, 3);
-  const SequenceOptions options = QuickOptions();
+  Capture capture = testing_util::OpenTinyCapture(root, 3);
+  const SequenceOptions options = testing_util::QuickSequenceOptions();
   const std::string whole = root + "/whole", parts = root + "/parts";
   const SequenceResult result = RefineSequence(&capture, {0, 3}, options, whole);
   EXPECT_TRUE(std::isnan(Record(whole, "000000").flicker_refined_mm));
@@ -217,74 +202,14 @@ TEST(RefineSequenceTest, FlickerFollowsTheFrameBeforeAcrossResumesAndShards) {
   }
 }
 
-// The RMS over the vertices refined in both of the change of k from frame `before` to `after`
-// in the run folder `out`, metres.
-double ChangeOfK(const std::string& out, const std::string& before, const std::string& after,
-                 int num_vertices) {
-  const Eigen::VectorXd a =
-      ReadDisplacement(FrameFilesIn(out, before, MeshFormat::kPly).displacement, num_vertices);
-  const Eigen::VectorXd b =
-      ReadDisplacement(FrameFilesIn(out, after, MeshFormat::kPly).displacement, num_vertices);
-  double sum2 = 0.0;
-  int count = 0;
-  for (int v = 0; v < num_vertices; ++v) {
-    if (!std::isfinite(a[v]) || !std::isfinite(b[v])) continue;
-    sum2 += (b[v] - a[v]) * (b[v] - a[v]);
-    ++count;
-  }
-  return count > 0 ? std::sqrt(sum2 / count) : std::nan("");
-}
-
-// energy.temporal_weight pulls each frame's k towards the frame before's: k changes less from
-// frame to frame. The pull reads the frame before from its saved files, so frame 1 resumed and
-// frame 2 refined by a run of its own give what one run gives.
-TEST(RefineSequenceTest, TheTemporalPullHoldsEachFrameNearerTheFrameBefore) {
-  const OneWorkerThread one_thread;
-  const std::string root = MakeTempDir("sequence_temporal");
-  Capture capture = OpenTinyCapture(root, 3);
-  const int num_vertices =
-      SequenceModel(capture.ReadCoarseMesh(0), {}, QuickOptions().refine, "test")
-          .num_fine_vertices();
-  SequenceOptions free_options = QuickOptions(), pulled_options = QuickOptions();
-  free_options.refine.energy.temporal_weight = 0.0;
-  pulled_options.refine.energy.temporal_weight = 20.0;
-  const std::string free = root + "/free", pulled = root + "/pulled", parts = root + "/parts";
-  RefineSequence(&capture, {0, 3}, free_options, free);
-  RefineSequence(&capture, {0, 3}, pulled_options, pulled);
-  for (const auto& [before, after] :
-       {std::pair<std::string, std::string>{"000000", "000001"}, {"000001", "000002"}}) {
-    const double free_change = ChangeOfK(free, before, after, num_vertices);
-    const double pulled_change = ChangeOfK(pulled, before, after, num_vertices);
-    EXPECT_GT(free_change, 0.0) << after;
-    EXPECT_LT(pulled_change, 0.5 * free_change) << after;
-  }
-  // Frame 0 has no frame before: the pull leaves it as it was.
-  EXPECT_EQ(FileBytes(FrameFilesIn(pulled, "000000", MeshFormat::kPly).displacement),
-            FileBytes(FrameFilesIn(free, "000000", MeshFormat::kPly).displacement));
-
-  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
-    RefineSequence(&capture, part, pulled_options, parts);
-  }
-  for (const std::string frame : {"000001", "000002"}) {
-    const Eigen::VectorXd whole_k =
-        ReadDisplacement(FrameFilesIn(pulled, frame, MeshFormat::kPly).displacement, num_vertices);
-    const Eigen::VectorXd parts_k =
-        ReadDisplacement(FrameFilesIn(parts, frame, MeshFormat::kPly).displacement, num_vertices);
-    EXPECT_LT(
-        (whole_k - parts_k).array().isFinite().select(whole_k - parts_k, 0.0).cwiseAbs().maxCoeff(),
-        1e-9)
-        << frame;
-  }
-}
-
 // The reference colours are saved with what they were made of; a run that would make them
 // otherwise (here: another quad-tree depth, which the file's own fields do not show) is refused,
 // while a file saved before recipes were still resumes.
 TEST(RefineSequenceTest, ReferenceColoursOfAnotherRecipeAreRefused) {
   const OneWorkerThread one_thread;
   const std::string root = MakeTempDir("sequence_recipe");
-  Capture capture = OpenTinyCapture(root, 2);
-  const SequenceOptions options = QuickOptions();
+  Capture capture = testing_util::OpenTinyCapture(root, 2);
+  const SequenceOptions options = testing_util::QuickSequenceOptions();
   const std::string out = root + "/run";
   fs::create_directories(out);
   RefineSequence(&capture, {0, 1}, options, out);

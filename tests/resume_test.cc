@@ -1,8 +1,8 @@
 // Long runs: `finecap refine` killed with SIGKILL in the middle of a frame leaves no partial file,
 // and the same command run again finishes with the results of a run that never stopped; two
 // shards run one after the other give the results of one whole run; `finecap status` lists what
-// is missing. Warm start and the temporal pull are on, so each frame's result depends on the frame
-// before it.
+// is missing. Warm start is on, so each frame's result depends on the frame before it (the
+// temporal term's own test resumes its pull, src/energy/terms/temporal/).
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -39,12 +39,11 @@ constexpr int kFrames = 4;
 
 // The arguments of every run: one thread, so that runs are repeatable to the last bit.
 std::vector<std::string> RefineArguments(const std::string& capture, const std::string& out) {
-  return {
-      FINECAP_BINARY, "refine",
-      "--capture",    capture,
-      "--out",        out,
-      "--threads",    "1",
-      "--set",        "refine.warm_start=true,energy.temporal_weight=0.3,solver.max_iterations=8"};
+  return {FINECAP_BINARY, "refine",
+          "--capture",    capture,
+          "--out",        out,
+          "--threads",    "1",
+          "--set",        "refine.warm_start=true,solver.max_iterations=8"};
 }
 
 // Starts the binary with `arguments`, its output discarded; returns its pid.

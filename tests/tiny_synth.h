@@ -5,6 +5,8 @@
 #include <string>
 
 #include "finecap/config/config.h"
+#include "finecap/io/capture.h"
+#include "finecap/refine/sequence.h"
 #include "finecap/synth/synth.h"
 
 namespace finecap {
@@ -53,6 +55,21 @@ inline SynthOptions TinyRefinableSynthOptions(int num_frames) {
   options.cameras.width = 96;
   options.cameras.height = 96;
   options.cameras.focal = 300.0;
+  return options;
+}
+
+// A tiny refinable capture of `frames` frames, generated in `root`/capture, opened.
+inline Capture OpenTinyCapture(const std::string& root, int frames) {
+  GenerateSyntheticCapture(TinyRefinableSynthOptions(frames), root + "/capture");
+  return Capture::Open(root + "/capture");
+}
+
+// Options that refine a tiny capture's sequence quickly: one thread, two iterations, no sweep.
+inline SequenceOptions QuickSequenceOptions() {
+  SequenceOptions options;
+  options.refine.solver.max_iterations = 2;
+  options.refine.solver.num_threads = 1;
+  options.refine.sweep.samples = 0;
   return options;
 }
 

@@ -7,6 +7,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "finecap/energy/term_options.h"
 #include "finecap/eval/optical_flow.h"
 #include "finecap/eval/run_evaluation.h"
 #include "finecap/util/error.h"
@@ -182,26 +183,33 @@ void AddSolverKeys(SolverOptions* solver, RefineOptions* refine, ConfigSchema* s
 
 // The config section of the fields of each options struct, so that a Check() failure naming a
 // field ("EnergyOptions::w_reg") is reported at its key ("energy.w_reg"): the sections follow the
-// structs, and RefineOptions' own fields are split between `model` and `refine`.
+// structs, and RefineOptions' own fields are split between `model` and `refine`. The terms'
+// structs are the registry's (term_options.h).
 const std::vector<std::pair<std::string, std::vector<std::string>>>& FieldSections() {
-  static const std::vector<std::pair<std::string, std::vector<std::string>>> sections = {
-      {"RefineOptions::", {"model.", "refine."}},
-      {"ReferenceColorOptions::", {"model."}},
-      {"ImageGaussianOptions::", {"image_gaussians."}},
-      {"VisibilityOptions::", {"visibility."}},
-      {"EnergyOptions::", {"energy."}},
-      {"ConsensusOptions::", {"energy.consensus."}},
-      {"SolverOptions::", {"solver."}},
-      {"SweepOptions::", {"refine.sweep."}},
-      {"CoarseToFineOptions::", {"refine.coarse_to_fine."}},
-      {"HeldOutOptions::", {"validation."}},
-      {"SequenceOptions::", {"model.", "refine.", "validation."}},
-      {"RunEvaluationOptions::", {"model.", "eval."}},
-      {"SynthOptions::", {"synth."}},
-      {"SkirtOptions::", {"synth.skirt."}},
-      {"TextureOptions::", {"synth.texture."}},
-      {"RigOptions::", {"synth.cameras."}},
-      {"RenderOptions::", {"synth.render."}}};
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> sections = [] {
+    std::vector<std::pair<std::string, std::vector<std::string>>> all = {
+        {"RefineOptions::", {"model.", "refine."}},
+        {"ReferenceColorOptions::", {"model."}},
+        {"ImageGaussianOptions::", {"image_gaussians."}},
+        {"VisibilityOptions::", {"visibility."}},
+        {"EnergyOptions::", {"energy."}},
+        {"ConsensusOptions::", {"energy.consensus."}},
+        {"SolverOptions::", {"solver."}},
+        {"SweepOptions::", {"refine.sweep."}},
+        {"CoarseToFineOptions::", {"refine.coarse_to_fine."}},
+        {"HeldOutOptions::", {"validation."}},
+        {"SequenceOptions::", {"model.", "refine.", "validation."}},
+        {"RunEvaluationOptions::", {"model.", "eval."}},
+        {"SynthOptions::", {"synth."}},
+        {"SkirtOptions::", {"synth.skirt."}},
+        {"TextureOptions::", {"synth.texture."}},
+        {"RigOptions::", {"synth.cameras."}},
+        {"RenderOptions::", {"synth.render."}}};
+    for (const TermOptionSection& term : TermOptionSections()) {
+      all.push_back({term.field_prefix, {term.key_prefix}});
+    }
+    return all;
+  }();
   return sections;
 }
 

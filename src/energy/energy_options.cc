@@ -48,10 +48,7 @@ const OptionFields<EnergyOptions>& EnergyOptions::Fields() {
                 "it (few cameras, steep views, wide plain regions), in units of the median data "
                 "curvature (not in the paper; 0: off).",
                 0.0, 1e6);
-    f.AddDouble("temporal_weight", &EnergyOptions::temporal_weight,
-                "Strength of a pull of k towards the frame before's solved k (temporal "
-                "coherence), in units of the median data curvature (not in the paper; 0: off).",
-                0.0, 1e6);
+    f.AddGroup(&EnergyOptions::terms, TermOptions::Fields());
     f.AddDouble("confidence_threshold", &EnergyOptions::confidence_threshold,
                 "Colour variation, as a fraction of its median, below which the cloth counts as "
                 "plain.",
@@ -116,6 +113,7 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
 void EnergyOptions::Check() const {
   Fields().CheckValues(*this, "EnergyOptions::");
   consensus.Check();
+  terms.Check();
 }
 
 void ConsensusOptions::Check() const { Fields().CheckValues(*this, "ConsensusOptions::"); }

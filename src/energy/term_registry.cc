@@ -6,7 +6,6 @@
 #include "energy/terms/prior/input_prior.h"
 #include "energy/terms/smoothness/smoothness_term.h"
 #include "energy/terms/surface_color/surface_color_similarity.h"
-#include "energy/terms/temporal/temporal_term.h"
 #include "finecap/energy/similarity_needs.h"
 #include "finecap/util/error.h"
 
@@ -59,9 +58,6 @@ std::vector<std::unique_ptr<QuadraticTerm>> MakeQuadraticTerms(const TermContext
   std::vector<std::unique_ptr<QuadraticTerm>> terms;
   terms.push_back(std::make_unique<SmoothnessTerm>(context));
   terms.push_back(std::make_unique<InputPriorTerm>(context));
-  if (context.options.temporal_weight > 0.0) {
-    terms.push_back(std::make_unique<TemporalTerm>(context));
-  }
   return terms;
 }
 
@@ -71,9 +67,23 @@ bool WeighsPairsByColor(const EnergyOptions& options) {
 
 }  // namespace internal
 
+const OptionFields<TermOptions>& TermOptions::Fields() {
+  static const OptionFields<TermOptions> fields = [] {
+    OptionFields<TermOptions> f;
+    return f;
+  }();
+  return fields;
+}
+
+void TermOptions::Check() const {}
+
+const std::vector<TermOptionSection>& TermOptionSections() {
+  static const std::vector<TermOptionSection> sections = {};
+  return sections;
+}
+
 SimilarityNeeds NeedsOf(const EnergyOptions& options) {
   SimilarityNeeds needs;
-  needs.reads_frame_before = options.temporal_weight > 0.0;
   if (options.similarity != SimilarityType::kConsensus) return needs;
   needs.cameras_per_gaussian = options.consensus.min_cameras;
   needs.takes_fallback_views = true;

@@ -179,10 +179,10 @@ void ScoreInHeldOutViews(const SequenceOptions& options, const SequenceModel& mo
 }
 
 // The solved displacement of the frame before `frame`, which seeds `frame` with
-// refine.warm_start and pulls it with energy.temporal_weight; empty when that frame is not done
-// in `out` (the frame then starts as a first frame). Always from the saved files, so that a
-// resumed run or a shard starts its first frame exactly as a run that never stopped starts every
-// frame.
+// refine.warm_start and reaches the terms that read it (SimilarityNeeds::reads_frame_before); empty
+// when that frame is not done in `out` (the frame then starts as a first frame). Always from the
+// saved files, so that a resumed run or a shard starts its first frame exactly as a run that never
+// stopped starts every frame.
 Eigen::VectorXd SolvedFrameBefore(const std::string& out, const Capture& capture, int frame,
                                   const SequenceOptions& options, const SequenceModel& model) {
   if (frame == 0) return {};

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "finecap/energy/term_options.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/util/enum_names.h"
 #include "finecap/util/option_fields.h"
@@ -91,16 +92,8 @@ struct EnergyOptions {
   // nothing. surface_color needs 300 (configs/surface_color.yaml): its single colours carry
   // nothing on plain cloth.
   double confidence_prior = 1.0;
-  // The frame before's displacement along its normal is carried to this frame by the input's own
-  // motion: the same k on this frame's surface. Read from the saved files of that frame (as
-  // refine.warm_start is), so that a resumed run pulls its first frame as an uninterrupted run
-  // does; the first frame of a capture, or one whose predecessor is not done (a shard run beside
-  // the one before it), is not pulled. 0.3 lowers both the error and the flicker of a noisy capture
-  // and holds the other synthetic captures within a few tenths of a point (docs/measurements.md,
-  // 2026-12-05). Off by default: with the pull a sequence is one chain, so shards run side by side
-  // (a Slurm array) would no longer equal one process at their first frames; a single process or
-  // shards run in turn get the same result with it.
-  double temporal_weight = 0.0;
+  // The options of the terms that own a section of their own (term_options.h).
+  TermOptions terms;
   ConsensusOptions consensus;
   // The plainness is exp(-V / (threshold * median V)).
   double confidence_threshold = 0.05;

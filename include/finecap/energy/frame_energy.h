@@ -97,7 +97,7 @@ class FrameEnergy {
   // (energy.confidence_prior) holds k_s at the input where it is low.
   const Eigen::VectorXd& confidence() const { return confidence_; }
   // Hands the displacement the frame before was solved with (one per surface Gaussian, NaN where
-  // it has none) to the terms that read it (the temporal pull), once it is known.
+  // it has none) to the terms that read it, once it is known.
   void TakeFrameBefore(const Eigen::VectorXd& k_before);
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;

@@ -29,8 +29,8 @@ struct SimilarityNeeds {
   // stage (ConsensusOptions::sample_spacing above 0).
   bool reads_surface_samples = false;
   // Whether a term reads the displacement the frame before was solved with
-  // (FrameEnergy::TakeFrameBefore): the temporal pull. A sequence then reads it from that frame's
-  // saved files, as it does for a warm start.
+  // (FrameEnergy::TakeFrameBefore), such as a temporal pull. A sequence then reads it from that
+  // frame's saved files, as it does for a warm start.
   bool reads_frame_before = false;
 };
 

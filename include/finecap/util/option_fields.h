@@ -12,7 +12,8 @@
 // A field's default is its member initialiser: the schema reads the current value.
 //
 // Fields are declared in the order their keys are listed. A nested options struct is a section
-// (AddSection) with a declaration and a Check() of its own, which CheckValues leaves to it. A field
+// (AddSection), or a group whose fields share the struct's own section (AddGroup), with a
+// declaration and a Check() of its own, which CheckValues leaves to it. A field
 // of a type that a declaration does not describe (a list of mappings, a 64-bit seed) is declared
 // with AddCustom, its doc and range here, its key made by the config.
 #ifndef FINECAP_UTIL_OPTION_FIELDS_H_
@@ -32,7 +33,17 @@ namespace finecap {
 
 // What is declared of one field, whatever its type.
 struct OptionField {
-  enum class Type { kInt, kDouble, kBool, kString, kChoice, kDoubleList, kCustom, kSection };
+  enum class Type {
+    kInt,
+    kDouble,
+    kBool,
+    kString,
+    kChoice,
+    kDoubleList,
+    kCustom,
+    kSection,
+    kGroup
+  };
 
   std::string name;  // Relative to the struct's section: "w_reg", "consensus".
   std::string doc;
@@ -179,6 +190,18 @@ class OptionFields {
           visitor->BeginSection(field);
           fields.Visit(&(object->*member), visitor);
           visitor->EndSection();
+        });
+    return *this;
+  }
+
+  // A nested options struct, declared by `fields`, whose fields are keys of this struct's own
+  // section, as if declared here: a group kept in a struct of its own (the terms' options, which
+  // their registry declares). Like a section, its Check() is its own.
+  template <typename Group>
+  OptionFields& AddGroup(Group Options::*member, const OptionFields<Group>& fields) {
+    Add(PlainField("", "", OptionField::Type::kGroup),
+        [member, &fields](const OptionField&, Options* object, OptionFieldVisitor* visitor) {
+          fields.Visit(&(object->*member), visitor);
         });
     return *this;
   }
