@@ -6,6 +6,7 @@
 #include "energy/terms/prior/input_prior.h"
 #include "energy/terms/smoothness/smoothness_term.h"
 #include "energy/terms/surface_color/surface_color_similarity.h"
+#include "energy/terms/temporal/temporal_term.h"
 #include "finecap/energy/similarity_needs.h"
 #include "finecap/util/error.h"
 
@@ -58,6 +59,9 @@ std::vector<std::unique_ptr<QuadraticTerm>> MakeQuadraticTerms(const TermContext
   std::vector<std::unique_ptr<QuadraticTerm>> terms;
   terms.push_back(std::make_unique<SmoothnessTerm>(context));
   terms.push_back(std::make_unique<InputPriorTerm>(context));
+  if (context.options.terms.temporal.IsOn()) {
+    terms.push_back(std::make_unique<TemporalTerm>(context, context.options.terms.temporal));
+  }
   return terms;
 }
 
@@ -70,20 +74,23 @@ bool WeighsPairsByColor(const EnergyOptions& options) {
 const OptionFields<TermOptions>& TermOptions::Fields() {
   static const OptionFields<TermOptions> fields = [] {
     OptionFields<TermOptions> f;
+    f.AddSection("temporal", &TermOptions::temporal, TemporalOptions::Fields());
     return f;
   }();
   return fields;
 }
 
-void TermOptions::Check() const {}
+void TermOptions::Check() const { temporal.Check(); }
 
 const std::vector<TermOptionSection>& TermOptionSections() {
-  static const std::vector<TermOptionSection> sections = {};
+  static const std::vector<TermOptionSection> sections = {
+      {"TemporalOptions::", "energy.temporal.", TemporalOptions::Fields().Declared()}};
   return sections;
 }
 
 SimilarityNeeds NeedsOf(const EnergyOptions& options) {
   SimilarityNeeds needs;
+  needs.reads_frame_before = options.terms.temporal.IsOn();
   if (options.similarity != SimilarityType::kConsensus) return needs;
   needs.cameras_per_gaussian = options.consensus.min_cameras;
   needs.takes_fallback_views = true;

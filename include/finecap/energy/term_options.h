@@ -9,11 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "finecap/energy/terms/temporal/temporal_options.h"
 #include "finecap/util/option_fields.h"
 
 namespace finecap {
 
 struct TermOptions {
+  TemporalOptions temporal;
+
   // The terms' sections, each a key group of `energy.` (EnergyOptions::Fields adds them).
   static const OptionFields<TermOptions>& Fields();  // option_fields.h
   void Check() const;
