@@ -151,6 +151,9 @@ struct FrameInput {
   // for the energy's terms that read it (SimilarityNeeds::reads_frame_before); empty: none. Set
   // only once that frame is solved, so it is never part of what is read or prepared ahead.
   Eigen::VectorXd frame_before_k;
+  // With energy.consensus.shared_appearance: the colours the frame before's refined surface
+  // showed at its surface samples (FrameResult::appearance); empty: none. Set as frame_before_k.
+  Eigen::Matrix3Xd frame_before_appearance;
 };
 
 // Builds input->image_models under `options`, unless they are already built with them.
@@ -290,6 +293,9 @@ struct FrameResult {
   // (FrameEnergy::confidence: the views that see it, the texture around it); NaN where not
   // refined. The confidence pull holds a vertex near its input where this is low.
   Eigen::VectorXd confidence;
+  // With energy.consensus.shared_appearance: the colour each surface sample shows at the refined
+  // surface (FrameEnergy::SampleAppearance), which the frame after compares its patches with.
+  Eigen::Matrix3Xd appearance;
   SolverSummary summary;
   bool worse = false;       // The solve ended with a lower energy than it started from.
   bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
