@@ -490,6 +490,7 @@ void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
   result->normals = ComputeVertexNormals(fine_input);
   result->k = result->k.array().isFinite().select(0.0 * result->k, result->k);
   result->kept_input = true;
+  result->appearance.resize(3, 0);
 }
 
 Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,

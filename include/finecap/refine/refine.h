@@ -152,7 +152,8 @@ struct FrameInput {
   // only once that frame is solved, so it is never part of what is read or prepared ahead.
   Eigen::VectorXd frame_before_k;
   // With energy.consensus.shared_appearance: the colours the frame before's refined surface
-  // showed at its surface samples (FrameResult::appearance); empty: none. Set as frame_before_k.
+  // showed at its surface samples (FrameResult::appearance); empty: none, and ignored when this
+  // frame's samples differ in number (another sampling level). Set as frame_before_k.
   Eigen::Matrix3Xd frame_before_appearance;
 };
 
@@ -334,7 +335,8 @@ Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
 
 // Puts the input surface back into `result` (its refined mesh, normals and k, which becomes 0
 // wherever it was refined) and sets kept_input, for a frame that another measure than the energy
-// found worse. `fine_input` is the frame's subdivided input mesh.
+// found worse; its appearance, which was the refined surface's, is dropped, so the frame after
+// compares its patches with none. `fine_input` is the frame's subdivided input mesh.
 void KeepInputSurface(const Mesh& fine_input, FrameResult* result);
 
 // Where the solve of `frame` starts: `warm_start` when given and of the right size, else the
