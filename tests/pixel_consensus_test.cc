@@ -310,5 +310,96 @@ TEST(PixelConsensusTest, AMaskCutsPatchesAlongItsEdgeInsteadOfDroppingThem) {
                Error);
 }
 
+// The appearance a frame's surface shows at its samples (SeenAppearance): at the true surface
+// every camera reads the texture there, so their mean is the texture; at a wrong surface they
+// read points of the plane apart from it and from each other. A sample no camera sees has none.
+TEST(PixelConsensusTest, SeenAppearanceIsTheTextureAtTheSurfaceFound) {
+  const double truth = 0.0013;
+  SampledScene scene = MakeSampledScene(truth);
+  for (CameraInput& camera : scene.cameras) camera.samples_visible[5] = 0;
+  const FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                           scene.samples);
+  const auto error_at = [&](double k) {
+    const Eigen::Matrix3Xd appearance =
+        energy.SampleAppearance(Eigen::VectorXd::Constant(energy.num_parameters(), k));
+    EXPECT_EQ(appearance.cols(), scene.samples.size());
+    EXPECT_TRUE(appearance.col(5).array().isNaN().all());
+    double sum = 0.0;
+    int count = 0;
+    for (int j = 0; j < scene.samples.size(); ++j) {
+      if (j == 5) continue;
+      // The grid's normals point to -z: the surface displaced by k lies at z = -k, where the
+      // sample's x and y do not change.
+      const Eigen::Vector3f texture =
+          WorldTexture(scene.samples.base(0, j), scene.samples.base(1, j));
+      sum += (appearance.col(j) - texture.cast<double>()).norm();
+      ++count;
+    }
+    return sum / count;
+  };
+  const double at_truth = error_at(truth), off = error_at(truth + 0.002);
+  EXPECT_LT(at_truth, 0.02);
+  EXPECT_GT(off, 4.0 * at_truth);
+}
+
+// The appearance of the frame before is one more view of each patch (shared_appearance): a patch
+// two cameras see gets a third comparison, and a patch one camera sees, which the cameras alone
+// leave out (min_cameras), is compared with it, at its best where the surface truly is. Without
+// the option, or without an appearance, nothing changes.
+TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
+  const double truth = 0.0009;
+  SampledScene scene = MakeSampledScene(truth);
+  EnergyOptions options = SampledOptions();
+  options.consensus.shared_appearance = true;
+  {
+    const FrameEnergy seen(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                           scene.samples);
+    scene.samples.appearance =
+        seen.SampleAppearance(Eigen::VectorXd::Constant(seen.num_parameters(), truth));
+  }
+  const FrameEnergy plain(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                          scene.samples);
+  const FrameEnergy shared(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                           scene.samples);
+  const auto& plain_blocks = plain.similarity().residual_blocks();
+  const auto& shared_blocks = shared.similarity().residual_blocks();
+  ASSERT_EQ(shared_blocks.size(), plain_blocks.size());
+  for (size_t b = 0; b < plain_blocks.size(); ++b) {
+    // Three cameras and the appearance: four views of the patch's samples.
+    EXPECT_EQ(3 * shared_blocks[b].num_residuals, 4 * plain_blocks[b].num_residuals);
+  }
+  EXPECT_NEAR(BestUniformDisplacement(shared), truth, 0.00015);
+
+  // One camera, tilted so that k moves its reads: alone it compares nothing; with the appearance
+  // every patch is compared, and the surface found is the true one.
+  scene.cameras.erase(scene.cameras.begin(), scene.cameras.begin() + 1);
+  scene.cameras.pop_back();
+  const FrameEnergy one_camera(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
+                               scene.samples);
+  EXPECT_TRUE(one_camera.similarity().residual_blocks().empty());
+  const FrameEnergy one_and_appearance(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                                       scene.samples);
+  EXPECT_EQ(one_and_appearance.similarity().residual_blocks().size(), plain_blocks.size());
+  EXPECT_NEAR(BestUniformDisplacement(one_and_appearance), truth, 0.00015);
+  Eigen::VectorXd analytic;
+  const Eigen::VectorXd k = RandomK(one_and_appearance.num_parameters(), 0.002, 6);
+  one_and_appearance.Evaluate(k, &analytic);
+  const Eigen::VectorXd numeric = NumericGradient(
+      [&](const Eigen::VectorXd& x) { return one_and_appearance.Evaluate(x, nullptr); }, k, 1e-8);
+  EXPECT_LE((analytic - numeric).cwiseAbs().maxCoeff(), 1e-3 * numeric.cwiseAbs().maxCoeff());
+
+  // Where a sample of a patch has no appearance the patch is compared by its cameras alone.
+  scene.samples.appearance.col(scene.samples.patches[0][0]).setConstant(std::nan(""));
+  const FrameEnergy partly(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                           scene.samples);
+  EXPECT_EQ(partly.similarity().residual_blocks().size(), plain_blocks.size() - 1);
+
+  // An appearance of the wrong size is refused.
+  scene.samples.appearance.conservativeResize(3, scene.samples.size() - 1);
+  EXPECT_THROW(
+      FrameEnergy(scene.surface, scene.cameras, scene.neighbourhoods, options, scene.samples),
+      Error);
+}
+
 }  // namespace
 }  // namespace finecap

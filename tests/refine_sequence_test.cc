@@ -202,6 +202,76 @@ TEST(RefineSequenceTest, FlickerFollowsTheFrameBeforeAcrossResumesAndShards) {
   }
 }
 
+// energy.consensus.shared_appearance: each frame saves the colours its refined surface showed at
+// its samples, and the frame after compares its patches with them too, read from that file, so
+// that frame 1 resumed and frame 2 refined by a run of its own give what one run gives. The first
+// frame has no frame before and is refined as without the option.
+TEST(RefineSequenceTest, TheSharedAppearanceComesFromTheFrameBeforesFile) {
+  const OneWorkerThread one_thread;
+  const std::string root = MakeTempDir("sequence_appearance");
+  Capture capture = testing_util::OpenTinyCapture(root, 3);
+  const int num_vertices =
+      SequenceModel(capture.ReadCoarseMesh(0), {}, testing_util::QuickSequenceOptions().refine, "test")
+          .num_fine_vertices();
+  SequenceOptions shared_options = testing_util::QuickSequenceOptions();
+  shared_options.refine.energy.consensus.shared_appearance = true;
+  const std::string plain = root + "/plain", shared = root + "/shared", parts = root + "/parts";
+  RefineSequence(&capture, {0, 3}, testing_util::QuickSequenceOptions(), plain);
+  RefineSequence(&capture, {0, 3}, shared_options, shared);
+  EXPECT_FALSE(fs::exists(AppearanceFolder(plain)));
+  for (const std::string frame : {"000000", "000001", "000002"}) {
+    const Eigen::Matrix3Xd appearance = ReadAppearance(AppearancePath(shared, frame));
+    EXPECT_GT(appearance.cols(), 4 * num_vertices) << frame;  // Finer than the vertices.
+    EXPECT_GT(appearance.array().isFinite().count(), appearance.size() / 2) << frame;
+  }
+  EXPECT_EQ(FileBytes(FrameFilesIn(shared, "000000", MeshFormat::kPly).displacement),
+            FileBytes(FrameFilesIn(plain, "000000", MeshFormat::kPly).displacement));
+  EXPECT_NE(FileBytes(FrameFilesIn(shared, "000001", MeshFormat::kPly).displacement),
+            FileBytes(FrameFilesIn(plain, "000001", MeshFormat::kPly).displacement));
+
+  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
+    RefineSequence(&capture, part, shared_options, parts);
+  }
+  for (const std::string frame : {"000001", "000002"}) {
+    EXPECT_EQ(FileBytes(AppearancePath(parts, frame)), FileBytes(AppearancePath(shared, frame)))
+        << frame;
+    const Eigen::VectorXd whole_k =
+        ReadDisplacement(FrameFilesIn(shared, frame, MeshFormat::kPly).displacement, num_vertices);
+    const Eigen::VectorXd parts_k =
+        ReadDisplacement(FrameFilesIn(parts, frame, MeshFormat::kPly).displacement, num_vertices);
+    EXPECT_LT(
+        (whole_k - parts_k).array().isFinite().select(whole_k - parts_k, 0.0).cwiseAbs().maxCoeff(),
+        1e-9)
+        << frame;
+  }
+}
+
+// appearance/<frame>.txt reads back to the very doubles written, nan included; a line that is not
+// three numbers is refused, naming the file.
+TEST(RefineSequenceTest, AppearanceFilesReadBackExactly) {
+  const std::string root = MakeTempDir("appearance_file");
+  Eigen::Matrix3Xd appearance(3, 3);
+  appearance << 0.1, 1.0 / 3.0, std::nan(""), -2.5e-7, 0.7, std::nan(""), 1.0, 2.0 / 7.0,
+      std::nan("");
+  const std::string path = root + "/a.txt";
+  WriteAppearance(path, appearance);
+  const Eigen::Matrix3Xd read = ReadAppearance(path);
+  ASSERT_EQ(read.cols(), 3);
+  for (int j = 0; j < 3; ++j) {
+    for (int channel = 0; channel < 3; ++channel) {
+      if (std::isnan(appearance(channel, j))) {
+        EXPECT_TRUE(std::isnan(read(channel, j)));
+      } else {
+        EXPECT_EQ(read(channel, j), appearance(channel, j));
+      }
+    }
+  }
+  WriteTextFileAtomically(path, "# colours\n0.1 0.2 0.3\n0.4 0.5\n");
+  ExpectErrorMentions([&] { ReadAppearance(path); }, {path, "line 3"});
+  WriteTextFileAtomically(path, "0.1 0.2 0.3 0.4\n");
+  ExpectErrorMentions([&] { ReadAppearance(path); }, {path, "line 1"});
+}
+
 // The reference colours are saved with what they were made of; a run that would make them
 // otherwise (here: another quad-tree depth, which the file's own fields do not show) is refused,
 // while a file saved before recipes were still resumes.

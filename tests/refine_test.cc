@@ -55,6 +55,38 @@ TEST_F(RefineFrameTest, CoarseToFineReportsTheConfiguredEnergy) {
   EXPECT_GE(scheduled.summary.iterations, 2);
 }
 
+// With energy.consensus.shared_appearance a frame hands on the appearance of its refined surface
+// at its samples, and the next frame given it solves to another surface than without it. A
+// frame whose input is put back by another measure (KeepInputSurface) hands on none: what it
+// showed was not the surface it writes.
+TEST_F(RefineFrameTest, AFrameHandsOnTheAppearanceOfTheSurfaceItWrites) {
+  Capture capture = Capture::Open(*directory_);
+  RefineOptions options;
+  options.solver.max_iterations = 3;
+  options.energy.consensus.shared_appearance = true;
+  const FrameInput first = ReadFrameInput(&capture, 0);
+  FrameInput second = ReadFrameInput(&capture, 1);
+  const SequenceModel model(first.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, first, options);
+
+  FrameResult result = RefineFrame(model, colors, first, options);
+  ASSERT_GT(result.appearance.cols(), model.num_fine_vertices());
+  EXPECT_GT(result.appearance.array().isFinite().count(), result.appearance.size() / 2);
+  const FrameResult alone = RefineFrame(model, colors, second, options);
+  second.frame_before_appearance = result.appearance;
+  const FrameResult shared = RefineFrame(model, colors, second, options);
+  EXPECT_GT((shared.k - alone.k).array().isFinite().select(shared.k - alone.k, 0.0).norm(), 0.0);
+  // Without the option the appearance is neither made nor read.
+  options.energy.consensus.shared_appearance = false;
+  const FrameResult off = RefineFrame(model, colors, second, options);
+  EXPECT_EQ(off.appearance.cols(), 0);
+  EXPECT_EQ((off.k - alone.k).array().isFinite().select(off.k - alone.k, 0.0).norm(), 0.0);
+
+  KeepInputSurface(model.Subdivide(first.coarse), &result);
+  EXPECT_TRUE(result.kept_input);
+  EXPECT_EQ(result.appearance.cols(), 0);
+}
+
 // A frame modelled ahead (ModelFrameImages) gives its own models to every stage that asks with the
 // same options, keeps those of the cameras left after the held-out ones are set aside, and is
 // modelled afresh under other options; the frame it solves to is the one it solves to unmodelled.

@@ -105,6 +105,10 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
                 "Consensus similarity with samples: standard deviation (pixels) of the blur of the "
                 "images the samples read.",
                 0.0, 8.0);
+    f.AddBool("shared_appearance", &ConsensusOptions::shared_appearance,
+              "Consensus similarity with samples: compare each patch also with the colours the "
+              "frame before's refined surface showed at its samples (the appearance shared by "
+              "the frames), as one more view.");
     return f;
   }();
   return fields;

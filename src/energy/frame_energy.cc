@@ -1,6 +1,7 @@
 #include "finecap/energy/frame_energy.h"
 
 #include "energy/term_registry.h"
+#include "energy/terms/consensus/pixel_consensus_similarity.h"
 #include "energy/terms/prior/input_prior.h"
 #include "finecap/util/error.h"
 
@@ -98,6 +99,13 @@ double FrameEnergy::DifferenceEnergy(const Eigen::VectorXd& k, Eigen::VectorXd* 
   double energy = 0.0;
   for (const auto& term : quadratic_terms_) energy += term->DifferenceEnergy(k, gradient);
   return energy;
+}
+
+Eigen::Matrix3Xd FrameEnergy::SampleAppearance(const Eigen::VectorXd& k) const {
+  if (samples_.size() == 0) return {};
+  Require(k.size() == surface_.size(), "FrameEnergy::SampleAppearance",
+          "one displacement per surface Gaussian expected");
+  return SeenAppearance(samples_, sample_cameras_, samples_.weights * k);
 }
 
 long FrameEnergy::num_pairs() const { return num_pairs_; }

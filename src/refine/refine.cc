@@ -266,6 +266,9 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
   const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
   SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
                                          model.neighbourhoods(), PatchRingsAt(options), levels);
+  if (consensus.shared_appearance && input.frame_before_appearance.cols() == samples.size()) {
+    samples.appearance = input.frame_before_appearance;
+  }
   const std::vector<cv::Mat> pixels =
       SampledImages(input, options.image.color_space, consensus.sample_blur);
   std::vector<CameraInput> cameras(input.cameras.size());
@@ -444,6 +447,12 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     result.refined.vertices.col(ids[s]) += displacement * frame.normals.col(ids[s]);
   }
   result.normals = ComputeVertexNormals(result.refined);
+  if (options.energy.consensus.shared_appearance && UsesSurfaceSamples(options)) {
+    const Eigen::VectorXd displacement = result.kept_input
+                                             ? Eigen::VectorXd(Eigen::VectorXd::Zero(k.size()))
+                                             : Eigen::VectorXd(k.array() + bias);
+    result.appearance = frame.energy->SampleAppearance(displacement);
+  }
   result.seconds_total = SecondsSince(start);
   return result;
 }
@@ -481,6 +490,7 @@ void KeepInputSurface(const Mesh& fine_input, FrameResult* result) {
   result->normals = ComputeVertexNormals(fine_input);
   result->k = result->k.array().isFinite().select(0.0 * result->k, result->k);
   result->kept_input = true;
+  result->appearance.resize(3, 0);
 }
 
 Eigen::VectorXd StartingPoint(PreparedFrame* frame, const SweepOptions& sweep,

@@ -63,6 +63,10 @@ std::string FollowedColorsFolder(const std::string& out) { return out + "/colors
 std::string FollowedColorsPath(const std::string& out, const std::string& frame) {
   return FollowedColorsFolder(out) + "/" + frame + ".txt";
 }
+std::string AppearanceFolder(const std::string& out) { return out + "/appearance"; }
+std::string AppearancePath(const std::string& out, const std::string& frame) {
+  return AppearanceFolder(out) + "/" + frame + ".txt";
+}
 std::string EvalFolder(const std::string& out) { return out + "/eval"; }
 std::string ExportFolder(const std::string& out) { return out + "/export"; }
 
@@ -125,6 +129,44 @@ Eigen::VectorXd ReadConfidence(const std::string& path, int num_vertices) {
   return ReadVertexValues(path, num_vertices, "confidences");
 }
 
+void WriteAppearance(const std::string& path, const Eigen::Matrix3Xd& appearance) {
+  std::string text =
+      "# colour of each surface sample at the refined surface, in the similarity's colour space; "
+      "nan where no camera saw it\n";
+  char number[64];
+  for (int j = 0; j < appearance.cols(); ++j) {
+    for (int channel = 0; channel < 3; ++channel) {
+      const auto written = std::to_chars(number, number + sizeof(number), appearance(channel, j));
+      text.append(number, written.ptr).push_back(channel < 2 ? ' ' : '\n');
+    }
+  }
+  WriteTextFileAtomically(path, text);
+}
+
+Eigen::Matrix3Xd ReadAppearance(const std::string& path) {
+  std::istringstream text(internal::ReadWholeFile(path));
+  std::vector<double> values;
+  std::string line;
+  for (int line_number = 1; std::getline(text, line); ++line_number) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string field;
+    int count = 0;
+    while (fields >> field) {
+      double value = 0.0;
+      Require(internal::ParseDouble(field, &value) && !std::isinf(value) && count < 3, path,
+              "line " + std::to_string(line_number) + ": expected three numbers or nan, got '" +
+                  line + "'");
+      values.push_back(value);
+      ++count;
+    }
+    Require(count == 3, path,
+            "line " + std::to_string(line_number) + ": expected three numbers, got '" + line + "'");
+  }
+  return Eigen::Map<const Eigen::Matrix3Xd>(values.data(), 3,
+                                            static_cast<Eigen::Index>(values.size() / 3));
+}
+
 std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,
                                              const std::vector<std::string>& frame_names, int frame,
                                              MeshFormat mesh_format) {
@@ -151,11 +193,12 @@ std::vector<RefinedFrame> FindRefinedFrames(const std::string& out,
   return done;
 }
 
-int PrepareRunSubfolders(const std::string& out, bool followed_colors) {
+int PrepareRunSubfolders(const std::string& out, bool followed_colors, bool shared_appearance) {
   int removed = RemoveStaleTemporaries(out);
   std::vector<std::string> folders;
   for (const char* name : kSubfolders) folders.push_back(out + "/" + name);
   if (followed_colors) folders.push_back(FollowedColorsFolder(out));
+  if (shared_appearance) folders.push_back(AppearanceFolder(out));
   for (const std::string& folder : folders) {
     std::error_code error;
     fs::create_directories(folder, error);

@@ -447,6 +447,9 @@ class SequenceRun {
                                        : Eigen::VectorXd();
     const Eigen::VectorXd warm_start = options_.refine.warm_start ? before : Eigen::VectorXd();
     if (pulled) input.frame_before_k = before;
+    if (options_.refine.energy.consensus.shared_appearance) {
+      input.frame_before_appearance = AppearanceBefore(frame);
+    }
     const ReferenceColors colors = ColorsFor(frame);
     RefineOptions refine = options_.refine;
     if (prepare_ahead_ && reader_.ReadsAhead()) {
@@ -469,10 +472,27 @@ class SequenceRun {
     if (FollowsColors(options_) && frame >= options_.reference_frame) {
       SaveFollowedColors(name, colors, input, result, stats.worse);
     }
+    if (result.appearance.cols() > 0) {
+      WriteAppearance(AppearancePath(out_, name), result.appearance);
+    }
     WriteFrame(FrameFilesIn(out_, name, options_.mesh_format), result, options_.mesh_format, &stats,
                start, cpu_seconds_at_start, log_);
     last_errors_ = std::move(errors);
     return stats;
+  }
+
+  // The appearance the frame before `frame` showed at its surface samples, from its saved file
+  // (energy.consensus.shared_appearance), so that a resumed run or a shard compares its first
+  // frame's patches with what a run that never stopped compares them with; empty when that frame
+  // is not done here or left no appearance.
+  Eigen::Matrix3Xd AppearanceBefore(int frame) const {
+    if (frame == 0) return {};
+    const std::string& previous = capture_->frame_name(frame - 1);
+    const std::string path = AppearancePath(out_, previous);
+    if (!FrameDone(FrameFilesIn(out_, previous, options_.mesh_format)) || !fs::exists(path)) {
+      return {};
+    }
+    return ReadAppearance(path);
   }
 
   // The signed errors of the frame before `frame`: those this run just measured, else from that
@@ -676,7 +696,8 @@ SequenceResult RefineSequence(Capture* capture, const FrameRange& frames,
   if (observer == nullptr) observer = &silent;
   const StatsLog log(out, capture->frame_names(), options.mesh_format);
   const auto prepare_folder = [&] {
-    const int stale = PrepareRunSubfolders(out, FollowsColors(options));
+    const int stale = PrepareRunSubfolders(out, FollowsColors(options),
+                                           options.refine.energy.consensus.shared_appearance);
     if (stale > 0) observer->StaleFilesRemoved(stale);
     log.Rebuild();
   };

@@ -54,6 +54,12 @@ struct ConsensusOptions {
   double sample_spacing = 1.0;
   // The samples read the blurred images by bilinear interpolation.
   double sample_blur = 0.4;
+  // The surface's appearance is the same in every frame while its shape changes: with it on, the
+  // colours the frame before's refined surface showed at each sample (averaged over the cameras
+  // that saw it; SurfaceSamples::appearance) are one more view every patch is compared with, so
+  // that a patch two cameras see gets a third comparison. Read from the run folder, as the
+  // temporal pull's frame before is.
+  bool shared_appearance = false;
 
   static const OptionFields<ConsensusOptions>& Fields();  // option_fields.h
   void Check() const;

@@ -54,6 +54,11 @@ struct SurfaceSamples {
   Eigen::SparseMatrix<double, Eigen::RowMajor> weights;
   // patches[s]: the samples with a weight on surface Gaussian s, the one at s itself first.
   std::vector<std::vector<int>> patches;
+  // Empty, or one colour per sample in the similarity's colour space, NaN where unknown: the
+  // surface's appearance at each sample as another frame showed it (SampleAppearance), compared
+  // with by the consensus similarity with ConsensusOptions::shared_appearance. The samples of a
+  // mesh of fixed topology are the same points of its faces in every frame.
+  Eigen::Matrix3Xd appearance;
 
   int size() const { return static_cast<int>(base.cols()); }
 };
@@ -99,6 +104,10 @@ class FrameEnergy {
   // Hands the displacement the frame before was solved with (one per surface Gaussian, NaN where
   // it has none) to the terms that read it, once it is known.
   void TakeFrameBefore(const Eigen::VectorXd& k_before);
+  // With samples: the colour each sample shows at the surface displaced by `k` (one per surface
+  // Gaussian), averaged over the cameras that see it (NaN where none does); empty without
+  // samples. What the next frame compares its patches with (SurfaceSamples::appearance).
+  Eigen::Matrix3Xd SampleAppearance(const Eigen::VectorXd& k) const;
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 

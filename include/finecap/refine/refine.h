@@ -151,6 +151,10 @@ struct FrameInput {
   // for the energy's terms that read it (SimilarityNeeds::reads_frame_before); empty: none. Set
   // only once that frame is solved, so it is never part of what is read or prepared ahead.
   Eigen::VectorXd frame_before_k;
+  // With energy.consensus.shared_appearance: the colours the frame before's refined surface
+  // showed at its surface samples (FrameResult::appearance); empty: none, and ignored when this
+  // frame's samples differ in number (another sampling level). Set as frame_before_k.
+  Eigen::Matrix3Xd frame_before_appearance;
 };
 
 // Builds input->image_models under `options`, unless they are already built with them.
@@ -290,6 +294,9 @@ struct FrameResult {
   // (FrameEnergy::confidence: the views that see it, the texture around it); NaN where not
   // refined. The confidence pull holds a vertex near its input where this is low.
   Eigen::VectorXd confidence;
+  // With energy.consensus.shared_appearance: the colour each surface sample shows at the refined
+  // surface (FrameEnergy::SampleAppearance), which the frame after compares its patches with.
+  Eigen::Matrix3Xd appearance;
   SolverSummary summary;
   bool worse = false;       // The solve ended with a lower energy than it started from.
   bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
@@ -328,7 +335,8 @@ Eigen::VectorXd SolvedDisplacement(const Eigen::VectorXd& k, bool kept_input,
 
 // Puts the input surface back into `result` (its refined mesh, normals and k, which becomes 0
 // wherever it was refined) and sets kept_input, for a frame that another measure than the energy
-// found worse. `fine_input` is the frame's subdivided input mesh.
+// found worse; its appearance, which was the refined surface's, is dropped, so the frame after
+// compares its patches with none. `fine_input` is the frame's subdivided input mesh.
 void KeepInputSurface(const Mesh& fine_input, FrameResult* result);
 
 // Where the solve of `frame` starts: `warm_start` when given and of the right size, else the

@@ -10,6 +10,8 @@
 //   stats.jsonl                every done frame's record, in frame order
 //   reference_colors.txt       the sequence's reference colours (surface_gaussians.h)
 //   colors/<frame>.txt         with model.follow_colors: the colours the frame after it uses
+//   appearance/<frame>.txt     with energy.consensus.shared_appearance: the colours the frame's
+//                              refined surface showed at its surface samples, for the frame after
 //   eval/, export/             what finecap eval and finecap export make of the run
 //
 // A frame is done when its mesh, its displacement and its stats record all exist. Each is written
@@ -53,6 +55,10 @@ std::string ReferenceColorsPath(const std::string& out);
 // Where the colours followed up to `frame` are kept (model.follow_colors), and their folder.
 std::string FollowedColorsPath(const std::string& out, const std::string& frame);
 std::string FollowedColorsFolder(const std::string& out);
+// Where the appearance of `frame`'s refined surface is kept (energy.consensus.shared_appearance),
+// and its folder.
+std::string AppearancePath(const std::string& out, const std::string& frame);
+std::string AppearanceFolder(const std::string& out);
 std::string EvalFolder(const std::string& out);
 std::string ExportFolder(const std::string& out);
 
@@ -68,6 +74,14 @@ Eigen::VectorXd ReadDisplacement(const std::string& path, int num_vertices);
 // confidence/<frame>.txt, as k/<frame>.txt: one number in [0, 1] (or nan) per fine vertex.
 void WriteConfidence(const std::string& path, const Eigen::VectorXd& confidence);
 Eigen::VectorXd ReadConfidence(const std::string& path, int num_vertices);
+
+// appearance/<frame>.txt: one colour per surface sample (FrameResult::appearance), three numbers
+// a line in the shortest form that reads back to the same double (nan where no camera saw the
+// sample), so that a frame that reads it compares its patches with exactly what a run that never
+// stopped compares them with. ReadAppearance throws an Error naming the file when a line is not
+// three numbers or nan.
+void WriteAppearance(const std::string& path, const Eigen::Matrix3Xd& appearance);
+Eigen::Matrix3Xd ReadAppearance(const std::string& path);
 
 // A done frame of a run folder.
 struct RefinedFrame {
@@ -90,9 +104,10 @@ std::optional<RefinedFrame> FindRefinedFrame(const std::string& out,
                                              MeshFormat mesh_format);
 
 // Creates the subfolders of a run folder (colors/ only for a run whose colours follow the
-// sequence) and removes the temporaries that killed runs left in it (RemoveStaleTemporaries);
-// returns how many were removed.
-int PrepareRunSubfolders(const std::string& out, bool followed_colors);
+// sequence, appearance/ only for one that shares the appearance between frames) and removes the
+// temporaries that killed runs left in it (RemoveStaleTemporaries); returns how many were removed.
+int PrepareRunSubfolders(const std::string& out, bool followed_colors,
+                         bool shared_appearance = false);
 
 // stats.jsonl of a run folder. Appending and rebuilding hold an advisory lock (flock on
 // out/.stats.lock), so shards sharing the folder never interleave their writes; a record is

@@ -47,17 +47,67 @@ inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, do
   }
 }
 
+// The homogeneous pixel of camera `projection` of a sample at `base` moved by `k` along `normal`,
+// and its k-derivative (a straight line).
+inline void ProjectSample(const Eigen::Matrix<double, 3, 4>& projection,
+                          const Eigen::Vector3d& base, const Eigen::Vector3d& normal, double k,
+                          double* x, double* y, double* dx, double* dy) {
+  const Eigen::Vector3d direction = projection.leftCols<3>() * normal;
+  const Eigen::Vector3d h = projection.leftCols<3>() * base + projection.col(3) + k * direction;
+  const double inverse_depth = 1.0 / h.z();
+  *x = h.x() * inverse_depth;
+  *y = h.y() * inverse_depth;
+  *dx = (direction.x() - *x * direction.z()) * inverse_depth;
+  *dy = (direction.y() - *y * direction.z()) * inverse_depth;
+}
+
+Eigen::Matrix<double, 3, 4> ProjectionOf(const Camera& camera) {
+  Eigen::Matrix<double, 3, 4> projection;
+  projection << camera.K * camera.R, camera.K * camera.t;
+  return projection;
+}
+
 }  // namespace
+
+Eigen::Matrix3Xd SeenAppearance(const SurfaceSamples& samples,
+                                const std::vector<CameraInput>& cameras,
+                                const Eigen::VectorXd& shape) {
+  Require(shape.size() == samples.size(), "SeenAppearance", "one shape entry per sample expected");
+  std::vector<Eigen::Matrix<double, 3, 4>> projections;
+  for (const CameraInput& camera : cameras) projections.push_back(ProjectionOf(camera.camera));
+  Eigen::Matrix3Xd appearance(3, samples.size());
+#pragma omp parallel for schedule(dynamic, 1024)
+  for (int j = 0; j < samples.size(); ++j) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int seen = 0;
+    for (size_t c = 0; c < cameras.size(); ++c) {
+      const CameraInput& camera = cameras[c];
+      if (camera.samples_visible[j] == 0) continue;
+      if (!camera.samples_on_foreground.empty() && camera.samples_on_foreground[j] == 0) continue;
+      double x, y, dx, dy;
+      ProjectSample(projections[c], samples.base.col(j), samples.normals.col(j), shape[j], &x, &y,
+                    &dx, &dy);
+      double color[3];
+      ReadBilinear(camera.pixels, x, y, dx, dy, color, nullptr);
+      sum += Eigen::Vector3d(color[0], color[1], color[2]);
+      ++seen;
+    }
+    appearance.col(j) = seen > 0 ? (sum / seen).eval() : Eigen::Vector3d::Constant(std::nan(""));
+  }
+  return appearance;
+}
 
 PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples,
                                                    const std::vector<CameraInput>& cameras,
                                                    const ConsensusOptions& options)
     : PatchAgreementTerm(options, static_cast<int>(cameras.size())),
       samples_(samples),
-      cameras_(cameras) {
+      cameras_(cameras),
+      appearance_view_(static_cast<int>(cameras.size())) {
+  Require(samples.appearance.cols() == 0 || samples.appearance.cols() == samples.size(),
+          "pixel consensus similarity", "the appearance must have one colour per sample, or none");
   for (const CameraInput& camera : cameras) {
-    projections_.emplace_back();
-    projections_.back() << camera.camera.K * camera.camera.R, camera.camera.K * camera.camera.t;
+    projections_.push_back(ProjectionOf(camera.camera));
     Require(camera.pixels.type() == CV_32FC3 && camera.pixels.cols >= 2 && camera.pixels.rows >= 2,
             camera.camera.name, "the samples need the camera's image, converted (CV_32FC3)");
     Require(camera.samples_visible.size() == static_cast<size_t>(samples.size()),
@@ -80,6 +130,8 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
     if (static_cast<int>(patch.size()) < kMinPatchSamples) continue;
     std::vector<int> seen_by, members;
     ComparablePart(patch, &seen_by, &members);
+    if (seen_by.empty()) continue;
+    if (AppearanceKnown(members)) seen_by.push_back(appearance_view_);
     if (static_cast<int>(seen_by.size()) >= options_.min_cameras) AddPatch(s, members, seen_by);
   }
   shape_ = Eigen::VectorXd::Zero(samples.size());
@@ -126,18 +178,20 @@ void PixelConsensusSimilarity::ComparablePart(const std::vector<int>& patch,
   }
 }
 
+bool PixelConsensusSimilarity::AppearanceKnown(const std::vector<int>& members) const {
+  if (!options_.shared_appearance || samples_.appearance.cols() == 0) return false;
+  return std::all_of(members.begin(), members.end(),
+                     [&](int j) { return samples_.appearance.col(j).allFinite(); });
+}
+
 void PixelConsensusSimilarity::SampleColor(int c, int j, double k, double* color,
                                            double* derivative) const {
   // The sample's homogeneous pixel h(k) = P (base + k normal): a straight line, so that the pixel
   // h_xy / h_z and its k-derivative (h'_xy - pixel h'_z) / h_z need no more than it.
-  const Eigen::Matrix<double, 3, 4>& projection = projections_[c];
-  const Eigen::Vector3d direction = projection.leftCols<3>() * samples_.normals.col(j);
-  const Eigen::Vector3d h =
-      projection.leftCols<3>() * samples_.base.col(j) + projection.col(3) + k * direction;
-  const double inverse_depth = 1.0 / h.z();
-  const double x = h.x() * inverse_depth, y = h.y() * inverse_depth;
-  ReadBilinear(cameras_[c].pixels, x, y, (direction.x() - x * direction.z()) * inverse_depth,
-               (direction.y() - y * direction.z()) * inverse_depth, color, derivative);
+  double x, y, dx, dy;
+  ProjectSample(projections_[c], samples_.base.col(j), samples_.normals.col(j), k, &x, &y, &dx,
+                &dy);
+  ReadBilinear(cameras_[c].pixels, x, y, dx, dy, color, derivative);
 }
 
 void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
@@ -147,6 +201,17 @@ void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
   const double centre_shape = parameter_shape_[blocks_[b].parameters[0]];
   for (int a = 0; a < num_cameras; ++a) {
     const int c = Cameras(b)[a];
+    if (c == appearance_view_) {
+      // The appearance stays where the frame that showed it put it: it does not move with k.
+      for (int m = 0; m < n; ++m) {
+        const int i = a * n + m;
+        for (int channel = 0; channel < 3; ++channel) {
+          colors[3 * i + channel] = samples_.appearance(channel, members[m]);
+          if (derivatives != nullptr) derivatives[3 * i + channel] = 0.0;
+        }
+      }
+      continue;
+    }
     for (int m = 0; m < n; ++m) {
       const int i = a * n + m;
       SampleColor(c, members[m], k + shape_[members[m]] - centre_shape, colors + 3 * i,

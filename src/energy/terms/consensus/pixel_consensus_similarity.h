@@ -18,9 +18,16 @@
 // k per surface Gaussian: the samples only read the images finer.
 //
 // A camera counts for a patch when it sees every sample of it (visibility of the input surface),
-// and a patch needs at least `min_cameras` such cameras. Colours are computed when asked, from
-// the images, without tables: a sample is read at the k of the two or three patches it belongs
-// to, and a bilinear read costs less than a table's Hermite interpolation.
+// and a patch needs at least `min_cameras` such cameras. With ConsensusOptions::shared_appearance
+// and the samples' appearance (SurfaceSamples::appearance) known on all of a patch, that
+// appearance is one more view of the patch, normalised and compared as a camera's colours are
+// (it does not move with k): the surface's colours do not change from frame to frame while its
+// shape does, so a patch that two cameras see gets a third comparison, and one that a single
+// camera sees is compared at all. It counts towards `min_cameras` as a camera does, but a patch
+// still needs a camera: the appearance alone says nothing about k. The normalisation takes out
+// the patch's gain and offset, which the shading of a surface that changed shape moves. Colours are
+// computed when asked, from the images, without tables: a sample is read at the k of the two or
+// three patches it belongs to, and a bilinear read costs less than a table's Hermite interpolation.
 #ifndef FINECAP_SRC_ENERGY_PIXEL_CONSENSUS_SIMILARITY_H_
 #define FINECAP_SRC_ENERGY_PIXEL_CONSENSUS_SIMILARITY_H_
 
@@ -33,6 +40,13 @@
 #include "finecap/energy/frame_energy.h"
 
 namespace finecap {
+
+// The colour each of `samples` shows at the surface displaced by `shape` (one entry per sample,
+// along its normal), averaged over the cameras of `cameras` that see it and, with masks, have it
+// on their foreground; NaN where none does. `cameras` as PixelConsensusSimilarity takes them.
+Eigen::Matrix3Xd SeenAppearance(const SurfaceSamples& samples,
+                                const std::vector<CameraInput>& cameras,
+                                const Eigen::VectorXd& shape);
 
 class PixelConsensusSimilarity : public PatchAgreementTerm {
  public:
@@ -57,8 +71,14 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // `color` and, when `derivative` is not null, dcolour/dk to it.
   void SampleColor(int c, int j, double k, double* color, double* derivative) const;
 
+  // Whether the patch's members all have a known appearance (SurfaceSamples::appearance).
+  bool AppearanceKnown(const std::vector<int>& members) const;
+
   const SurfaceSamples& samples_;
   const std::vector<CameraInput>& cameras_;
+  // The camera index that stands for the samples' appearance in a patch's cameras: after every
+  // camera, so that a patch's cameras stay ascending.
+  int appearance_view_;
   // Per camera, K [R | t]: the homogeneous pixel of a world point (the images are undistorted).
   std::vector<Eigen::Matrix<double, 3, 4>> projections_;
   Eigen::VectorXd shape_;            // Per sample.
