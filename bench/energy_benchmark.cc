@@ -117,14 +117,14 @@ void BM_EnergyAndGradientAtSweep(benchmark::State& state) {
 BENCHMARK(BM_EnergyAndGradientAtSweep)->Unit(benchmark::kMillisecond);
 
 // The same point, prepared as Ceres' evaluation callback prepares it: each block's |r|^2, J^T r and
-// J^T J (SimilarityTerm::PrepareBlockSummaries), on one thread.
+// J^T J (BlockSummaries::PrepareBlockSummaries), on one thread.
 void BM_BlockSummariesAtSweep(benchmark::State& state) {
   const SkirtFrame& skirt = Skirt();
   const RefineOptions options;
   PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
   omp_set_num_threads(1);
-  for (auto _ : state) frame.energy->similarity().PrepareBlockSummaries(k);
+  for (auto _ : state) frame.energy->data_term(0).block_summaries()->PrepareBlockSummaries(k);
   omp_set_num_threads(omp_get_num_procs());
 }
 BENCHMARK(BM_BlockSummariesAtSweep)->Unit(benchmark::kMillisecond);
@@ -140,11 +140,11 @@ void BM_DetailBlockSummaries(benchmark::State& state) {
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
   PrepareDetailEnergy(*skirt.model, skirt.input, options, &frame);
   omp_set_num_threads(threads);
-  for (auto _ : state) frame.energy->similarity().PrepareBlockSummaries(k);
+  for (auto _ : state) frame.energy->data_term(0).block_summaries()->PrepareBlockSummaries(k);
   omp_set_num_threads(omp_get_num_procs());
   state.counters["threads"] = threads;
   state.counters["blocks"] =
-      static_cast<double>(frame.energy->similarity().residual_blocks().size());
+      static_cast<double>(frame.energy->data_term(0).residual_blocks().size());
 }
 BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 

@@ -55,7 +55,7 @@ TEST_P(EnergyDerivativeTest, ResidualJacobiansMatchCentralDifferences) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.7, 1.3}, 3, 9);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options(similarity, overlap));
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.003, 17);
   const double h = 1e-7;
   term.PrepareResiduals(k, true);
@@ -97,7 +97,7 @@ TEST_P(ScalarAndResidualsTest, ScalarIsMinusHalfTheSumOfSquaredResiduals) {
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options(GetParam(), "printed"));
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.005, 4);
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   ASSERT_GT(term.residual_blocks().size(), 10u);
   term.PrepareResiduals(k, false);
   double sum = 0.0;
@@ -116,7 +116,7 @@ TEST_P(ScalarAndResidualsTest, BlockCostsAreEachBlocksSumOfSquares) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options(GetParam(), "printed"));
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
   ASSERT_GT(num_blocks, 10);
   for (const Eigen::VectorXd& k :
@@ -144,16 +144,17 @@ INSTANTIATE_TEST_SUITE_P(SumOfSquares, ScalarAndResidualsTest,
 
 // The plane sweep's costs for every similarity: UniformBlockCosts at each displacement is
 // BlockCosts there, to the bit (for consensus, several displacements at a time against one).
-TEST(SimilarityTermTest, UniformBlockCostsAreBlockCostsAtEachDisplacement) {
+TEST(DataTermTest, UniformBlockCostsAreBlockCostsAtEachDisplacement) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
   for (const std::string similarity : {"paper", "surface_color", "consensus"}) {
     FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                        Options(similarity, "printed"));
-    SimilarityTerm& term = energy.similarity();
+    DataTerm& term = energy.data_term(0);
     const int n = energy.num_parameters();
     const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(9, -0.01, 0.01);
     Eigen::MatrixXd costs;
-    term.UniformBlockCosts(n, displacements, &costs);
+    ASSERT_NE(term.sweep_costs(), nullptr) << similarity;
+    term.sweep_costs()->UniformBlockCosts(n, displacements, &costs);
     ASSERT_EQ(costs.rows(), static_cast<Eigen::Index>(term.residual_blocks().size()));
     ASSERT_EQ(costs.cols(), displacements.size());
     for (int j = 0; j < displacements.size(); ++j) {
@@ -194,7 +195,7 @@ TEST_P(ConsensusUniformCostsTest, CostsAreThoseOfTheResidualPath) {
   options.consensus.contrast_floor = variant.contrast_floor;
   options.consensus.robust_fraction = variant.robust_fraction;
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
-  auto& consensus = dynamic_cast<ConsensusSimilarity&>(energy.similarity());
+  auto& consensus = dynamic_cast<ConsensusSimilarity&>(energy.data_term(0));
   const auto& blocks = consensus.residual_blocks();
   ASSERT_GT(blocks.size(), 10u);
   const int n = energy.num_parameters();
@@ -247,7 +248,7 @@ TEST(ConsensusSimilarityTest, IgnoresEachCamerasGainAndOffset) {
   const Eigen::VectorXd k = RandomK(scene.surface.size(), 0.004, 2);
   const auto residuals_of = [&](const EnergyScene& s) {
     FrameEnergy energy(s.surface, s.cameras, s.neighbourhoods, options);
-    SimilarityTerm& term = energy.similarity();
+    DataTerm& term = energy.data_term(0);
     term.PrepareResiduals(k, false);
     std::vector<std::vector<double>> all;
     for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
@@ -297,7 +298,7 @@ TEST(ConsensusSimilarityTest, TablesHoldTheImageColourAtTheirNodes) {
     EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 6);
     const EnergyOptions options = Options("consensus", form);
     FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
-    const auto& consensus = dynamic_cast<const ConsensusSimilarity&>(energy.similarity());
+    const auto& consensus = dynamic_cast<const ConsensusSimilarity&>(energy.data_term(0));
     const int num_nodes =
         ConsensusSimilarity::NumTableNodes(scene.surface.sigma_hat, options.k_max);
     const double step = 2.0 * options.k_max / (num_nodes - 1);
@@ -377,7 +378,7 @@ TEST(ConsensusSimilarityTest, PlainSurfaceCarriesNoWeight) {
                      Options("consensus", "printed"));
   Eigen::VectorXd gradient;
   const double value =
-      energy.similarity().Evaluate(RandomK(scene.surface.size(), 0.004, 1), &gradient);
+      energy.data_term(0).Evaluate(RandomK(scene.surface.size(), 0.004, 1), &gradient);
   EXPECT_NEAR(value, 0.0, 1e-20);
   EXPECT_LT(gradient.cwiseAbs().maxCoeff(), 1e-12);
 }
@@ -389,9 +390,9 @@ TEST(PaperSimilarityTest, GradientNearTheClampMatches) {
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, Options("paper", "exact"));
   const Eigen::VectorXd k = Eigen::VectorXd::Zero(energy.num_parameters());
   Eigen::VectorXd analytic;
-  const double value = energy.similarity().Evaluate(k, &analytic);
+  const double value = energy.data_term(0).Evaluate(k, &analytic);
   const Eigen::VectorXd numeric = NumericGradient(
-      [&](const Eigen::VectorXd& x) { return energy.similarity().Evaluate(x, nullptr); }, k, 1e-8);
+      [&](const Eigen::VectorXd& x) { return energy.data_term(0).Evaluate(x, nullptr); }, k, 1e-8);
   EXPECT_GT(value, 0.0);
   EXPECT_LT((analytic - numeric).norm(), 1e-5 * numeric.norm() + 1e-9);
 }

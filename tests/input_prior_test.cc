@@ -12,7 +12,7 @@ namespace finecap {
 namespace {
 
 // Every residual of the similarity at k, in block order.
-std::vector<double> AllResiduals(SimilarityTerm* term, const Eigen::VectorXd& k) {
+std::vector<double> AllResiduals(DataTerm* term, const Eigen::VectorXd& k) {
   term->PrepareResiduals(k, false);
   std::vector<double> all;
   for (int b = 0; b < static_cast<int>(term->residual_blocks().size()); ++b) {
@@ -34,14 +34,14 @@ TEST(DataCurvatureTest, IsTheSumOfSquaredResidualSlopes) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.5}, 3, 5);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SurfaceColorOptions(0));
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, 6);
-  const Eigen::VectorXd curvature = DataCurvature(&energy.similarity(), k);
+  const Eigen::VectorXd curvature = DataCurvature(&energy.data_term(0), k);
   const double h = 1e-7;
   for (int s = 0; s < k.size(); ++s) {
     Eigen::VectorXd plus = k, minus = k;
     plus[s] += h;
     minus[s] -= h;
-    const std::vector<double> r_plus = AllResiduals(&energy.similarity(), plus);
-    const std::vector<double> r_minus = AllResiduals(&energy.similarity(), minus);
+    const std::vector<double> r_plus = AllResiduals(&energy.data_term(0), plus);
+    const std::vector<double> r_minus = AllResiduals(&energy.data_term(0), minus);
     double expected = 0.0;
     for (size_t r = 0; r < r_plus.size(); ++r) {
       const double slope = (r_plus[r] - r_minus[r]) / (2.0 * h);

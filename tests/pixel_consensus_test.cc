@@ -86,7 +86,7 @@ SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
 double BestUniformDisplacement(const FrameEnergy& energy) {
   double best_k = 0.0, best = -std::numeric_limits<double>::infinity();
   for (double k = -0.003; k <= 0.003; k += 0.0001) {
-    const double value = energy.similarity().Evaluate(
+    const double value = energy.data_term(0).Evaluate(
         Eigen::VectorXd::Constant(energy.num_parameters(), k), nullptr);
     if (value > best) {
       best = value;
@@ -163,7 +163,7 @@ TEST(PixelConsensusTest, GradientMatchesCentralDifferences) {
   const SampledScene scene = MakeSampledScene(0.0015);
   const FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                            scene.samples);
-  ASSERT_GT(energy.similarity().residual_blocks().size(), 20u);
+  ASSERT_GT(energy.data_term(0).residual_blocks().size(), 20u);
   int disagreeing = 0, checked = 0;
   for (unsigned trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, trial);
@@ -184,7 +184,7 @@ TEST(PixelConsensusTest, ResidualJacobiansMatchCentralDifferences) {
   const SampledScene scene = MakeSampledScene(0.001);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                      scene.samples);
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, 3);
   const double h = 1e-8;
   int checked = 0, disagreeing = 0;
@@ -218,14 +218,16 @@ TEST(PixelConsensusTest, ScalarIsMinusHalfTheSumOfTheBlockCosts) {
   const SampledScene scene = MakeSampledScene(0.001);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                      scene.samples);
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   const Eigen::VectorXd k = RandomK(energy.num_parameters(), 0.002, 8);
   std::vector<double> costs;
   term.BlockCosts(k, &costs);
-  term.PrepareBlockSummaries(k);
+  BlockSummaries* summaries = term.block_summaries();
+  ASSERT_NE(summaries, nullptr);
+  summaries->PrepareBlockSummaries(k);
   double sum = 0.0;
   for (size_t b = 0; b < costs.size(); ++b) {
-    EXPECT_NEAR(term.BlockSummaryOf(static_cast<int>(b)).squared_norm, costs[b],
+    EXPECT_NEAR(summaries->BlockSummaryOf(static_cast<int>(b)).squared_norm, costs[b],
                 1e-12 * std::max(costs[b], 1.0));
     sum += costs[b];
   }
@@ -244,25 +246,27 @@ TEST(PixelConsensusTest, UniformDisplacementIsBestAtTheTruePlane) {
   }
 }
 
-// A patch shaped like the surface found before reads each sample at the blend of that shape.
+// A patch shaped like the surface found before (the term's PassHook, through the energy) reads
+// each sample at the blend of that shape.
 TEST(PixelConsensusTest, PatchShapeMovesTheSamplesByTheBlendedShape) {
   const SampledScene scene = MakeSampledScene(0.0);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                      scene.samples);
-  SimilarityTerm& term = energy.similarity();
-  ASSERT_TRUE(term.ShapesPatches());
+  DataTerm& term = energy.data_term(0);
+  ASSERT_NE(term.pass_hook(), nullptr);
+  ASSERT_TRUE(energy.HasPassHooks());
   const int n = energy.num_parameters();
   // A shape that is the same everywhere is no shape: every sample moves with its patch's k.
   const Eigen::VectorXd k = RandomK(n, 0.001, 4);
   const double unshaped = term.Evaluate(k, nullptr);
-  term.SetPatchShape(Eigen::VectorXd::Constant(n, 0.0007));
+  energy.EndOfPass(Eigen::VectorXd::Constant(n, 0.0007));
   EXPECT_NEAR(term.Evaluate(k, nullptr), unshaped, 1e-12 * std::abs(unshaped));
   // A tilted shape changes what the patches read.
   Eigen::VectorXd tilted(n);
   for (int s = 0; s < n; ++s) tilted[s] = 0.1 * scene.mesh.vertices(0, s);
-  term.SetPatchShape(tilted);
+  energy.EndOfPass(tilted);
   EXPECT_GT(std::abs(term.Evaluate(k, nullptr) - unshaped), 1e-6 * std::abs(unshaped));
-  EXPECT_THROW(term.SetPatchShape(Eigen::VectorXd::Zero(n + 1)), Error);
+  EXPECT_THROW(energy.EndOfPass(Eigen::VectorXd::Zero(n + 1)), Error);
 }
 
 // A foreground mask cuts the patches along a silhouette; it does not drop them. Here the first
@@ -279,8 +283,8 @@ TEST(PixelConsensusTest, AMaskCutsPatchesAlongItsEdgeInsteadOfDroppingThem) {
   for (int j = 0; j < scene.samples.size(); ++j) foreground[j] = scene.samples.base(0, j) < 0.0;
   const FrameEnergy cut(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                         scene.samples);
-  const auto& whole_blocks = whole.similarity().residual_blocks();
-  const auto& cut_blocks = cut.similarity().residual_blocks();
+  const auto& whole_blocks = whole.data_term(0).residual_blocks();
+  const auto& cut_blocks = cut.data_term(0).residual_blocks();
   ASSERT_EQ(cut_blocks.size(), whole_blocks.size());
   int shrunk = 0, two_cameras = 0;
   for (size_t b = 0; b < cut_blocks.size(); ++b) {
@@ -361,8 +365,8 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
                           scene.samples);
   const FrameEnergy shared(scene.surface, scene.cameras, scene.neighbourhoods, options,
                            scene.samples);
-  const auto& plain_blocks = plain.similarity().residual_blocks();
-  const auto& shared_blocks = shared.similarity().residual_blocks();
+  const auto& plain_blocks = plain.data_term(0).residual_blocks();
+  const auto& shared_blocks = shared.data_term(0).residual_blocks();
   ASSERT_EQ(shared_blocks.size(), plain_blocks.size());
   for (size_t b = 0; b < plain_blocks.size(); ++b) {
     // Three cameras and the appearance: four views of the patch's samples.
@@ -376,10 +380,10 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
   scene.cameras.pop_back();
   const FrameEnergy one_camera(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),
                                scene.samples);
-  EXPECT_TRUE(one_camera.similarity().residual_blocks().empty());
+  EXPECT_TRUE(one_camera.data_term(0).residual_blocks().empty());
   const FrameEnergy one_and_appearance(scene.surface, scene.cameras, scene.neighbourhoods, options,
                                        scene.samples);
-  EXPECT_EQ(one_and_appearance.similarity().residual_blocks().size(), plain_blocks.size());
+  EXPECT_EQ(one_and_appearance.data_term(0).residual_blocks().size(), plain_blocks.size());
   EXPECT_NEAR(BestUniformDisplacement(one_and_appearance), truth, 0.00015);
   Eigen::VectorXd analytic;
   const Eigen::VectorXd k = RandomK(one_and_appearance.num_parameters(), 0.002, 6);
@@ -392,7 +396,7 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
   scene.samples.appearance.col(scene.samples.patches[0][0]).setConstant(std::nan(""));
   const FrameEnergy partly(scene.surface, scene.cameras, scene.neighbourhoods, options,
                            scene.samples);
-  EXPECT_EQ(partly.similarity().residual_blocks().size(), plain_blocks.size() - 1);
+  EXPECT_EQ(partly.data_term(0).residual_blocks().size(), plain_blocks.size() - 1);
 
   // An appearance of the wrong size is refused.
   scene.samples.appearance.conservativeResize(3, scene.samples.size() - 1);

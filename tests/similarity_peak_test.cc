@@ -84,7 +84,7 @@ double BestAmplitude(const RefineOptions& options, const Mesh& flat,
   double best_amplitude = 0.0, best = -1e300;
   for (int step = -20; step <= 40; ++step) {
     const double amplitude = 2.0 * kAmplitude * step / 40;
-    const double value = energy.similarity().Evaluate(amplitude * shape, nullptr);
+    const double value = energy.data_term(0).Evaluate(amplitude * shape, nullptr);
     if (value > best) best = value, best_amplitude = amplitude;
   }
   return best_amplitude;

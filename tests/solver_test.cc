@@ -66,11 +66,11 @@ TEST_P(CeresCostTest, SimilarityBlocksPassTheGradientChecker) {
   CostScene scene(similarity, overlap);
   FrameEnergy& energy = scene.energy;
   const Eigen::VectorXd& k = scene.k;
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
   int checked = 0, failed = 0;
   for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 40)) {
-    const IsolatedSimilarityBlockCost cost(&term, b, k);
+    const IsolatedDataBlockCost cost(&term, b, k);
     std::vector<double> values;
     for (int s : term.residual_blocks()[b].parameters) values.push_back(k[s]);
     std::string error;
@@ -121,7 +121,7 @@ TEST(CeresCostTest, SmoothnessBlocksPassTheGradientChecker) {
 TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
   const auto [similarity, overlap] = GetParam();
   CostScene scene(similarity, overlap);
-  SimilarityTerm& term = scene.energy.similarity();
+  DataTerm& term = scene.energy.data_term(0);
   Eigen::VectorXd point = scene.k;
   double seconds = 0.0;
   const std::vector<SmoothnessBlockCost::Neighbour> neighbours = {{1, 3.5}, {-1, 1.5}, {2, 2.0}};
@@ -132,10 +132,11 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
   for (int b = 0; b < num_blocks; b += std::max(1, num_blocks / 20)) {
     if (term.residual_blocks()[b].parameters.size() != 1) continue;
     const int s = term.residual_blocks()[b].parameters[0];
-    GaussianModelRows rows(term, true);
-    const int row = rows.Add(s, b, kPrior);
+    GaussianModelRows rows(true);
+    const int row = rows.Add(s, kPrior);
+    rows.AddBlock(row, term.block_summaries(), b);
     const RemainderCost remainder(rows);
-    SharedEvaluationCallback callback(&term, &point, &seconds);
+    SharedEvaluationCallback callback({&term}, &point, &seconds);
     callback.PrepareRowsToo(&rows);
     const SurfaceGaussianCost cost(rows, row, neighbours.data(),
                                    static_cast<int>(neighbours.size()), 2);
@@ -193,7 +194,7 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
       }
     }
     // The row's curvature is the similarity's (the secant's, within its bounds) plus the prior's.
-    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    const BlockSummary& summary = term.block_summaries()->BlockSummaryOf(b);
     EXPECT_GE(columns[0][0] * columns[0][0],
               BlockCurvature::kMinSecantFactor * summary.curvature + kPrior - 1e-12)
         << "block " << b;
@@ -226,14 +227,17 @@ TEST_P(CeresCostTest, SurfaceGaussianBlocksHaveTheGradientOfTheirCost) {
 // would take the secant's history for a step of length zero.
 TEST(CeresCostTest, TheCallbackPreparesTheRowsOncePerPointWithJacobians) {
   CostScene scene("consensus", "printed");
-  SimilarityTerm& term = scene.energy.similarity();
+  DataTerm& term = scene.energy.data_term(0);
   Eigen::VectorXd point = scene.k;
   double seconds = 0.0;
-  GaussianModelRows rows(term, true);
+  GaussianModelRows rows(true);
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
-  for (int b = 0; b < num_blocks; ++b) rows.Add(term.residual_blocks()[b].parameters[0], b, 0.0);
+  for (int b = 0; b < num_blocks; ++b) {
+    rows.AddBlock(rows.Add(term.residual_blocks()[b].parameters[0], 0.0), term.block_summaries(),
+                  b);
+  }
   ASSERT_GT(rows.size(), 10);
-  SharedEvaluationCallback callback(&term, &point, &seconds);
+  SharedEvaluationCallback callback({&term}, &point, &seconds);
   callback.PrepareRowsToo(&rows);
   auto lengths = [&] {
     std::vector<double> values;
@@ -244,8 +248,9 @@ TEST(CeresCostTest, TheCallbackPreparesTheRowsOncePerPointWithJacobians) {
   EXPECT_EQ(lengths(), std::vector<double>(rows.size(), 0.0)) << "prepared for a cost alone";
   callback.PrepareForEvaluation(true, false);
   for (int i = 0; i < rows.size(); ++i) {
-    EXPECT_NEAR(rows.Length(i) * rows.Length(i), term.BlockSummaryOf(i).curvature,
-                1e-12 * (1.0 + term.BlockSummaryOf(i).curvature));
+    EXPECT_NEAR(rows.Length(i) * rows.Length(i),
+                term.block_summaries()->BlockSummaryOf(i).curvature,
+                1e-12 * (1.0 + term.block_summaries()->BlockSummaryOf(i).curvature));
   }
   point.array() += 0.0003;
   callback.PrepareForEvaluation(false, true);
@@ -253,8 +258,9 @@ TEST(CeresCostTest, TheCallbackPreparesTheRowsOncePerPointWithJacobians) {
   const std::vector<double> secant = lengths();
   int differ = 0;
   for (int i = 0; i < rows.size(); ++i) {
-    differ += std::abs(secant[i] * secant[i] - term.BlockSummaryOf(i).curvature) >
-              1e-6 * term.BlockSummaryOf(i).curvature;
+    differ +=
+        std::abs(secant[i] * secant[i] - term.block_summaries()->BlockSummaryOf(i).curvature) >
+        1e-6 * term.block_summaries()->BlockSummaryOf(i).curvature;
   }
   EXPECT_GT(differ, 0) << "the secant's curvature is J^T J's everywhere";
   callback.PrepareForEvaluation(true, false);
@@ -282,7 +288,7 @@ TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
     ceres::Problem::Options problem_options;
     problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem problem(problem_options);
-    cost_functions.AddResidualBlocks(energy, true, layout, &k, &problem);
+    cost_functions.AddResidualBlocks(&energy, true, layout, &k, &problem);
     *num_residuals = problem.NumResiduals();
     return problem.NumResidualBlocks();
   };
@@ -295,7 +301,7 @@ TEST_P(CeresCostTest, PerGaussianBlocksTakeTheStepsOfSeparateBlocks) {
     // two and the prior's.
     EXPECT_EQ(merged_blocks, energy.num_parameters() + 1);
     int with_row = 0, with_prior = 0;
-    for (const SimilarityTerm::ResidualBlock& block : energy.similarity().residual_blocks()) {
+    for (const DataTerm::ResidualBlock& block : energy.data_term(0).residual_blocks()) {
       ++with_row;
       with_prior += energy.pull_curvature()[block.parameters[0]] > 0.0;
     }
@@ -329,7 +335,7 @@ TEST(FrameSolverTest, PassesOnOneProblemTakeTheStepsOfFreshProblems) {
   EnergyScene scene = MakeEnergyScene({0.0, 0.8, 1.3}, 3, 31);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      Options("consensus", "exact"));
-  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy.similarity());
+  auto* consensus = dynamic_cast<ConsensusSimilarity*>(&energy.data_term(0));
   ASSERT_NE(consensus, nullptr);
   Eigen::VectorXd start(energy.num_parameters());
   for (int s = 0; s < start.size(); ++s) start[s] = 0.002 * std::sin(1.7 * s);
@@ -468,7 +474,7 @@ TEST(SolverTest, CeresProblemHasTheLeastSquaresCost) {
 }
 
 // Counts the preparations it is asked for.
-class CountingTerm : public SimilarityTerm {
+class CountingTerm : public DataTerm {
  public:
   double Evaluate(const Eigen::VectorXd&, Eigen::VectorXd*) const override { return 0.0; }
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
@@ -488,7 +494,7 @@ TEST(CeresCostTest, TheCallbackPreparesEachPointOnce) {
   CountingTerm term;
   Eigen::VectorXd k = Eigen::VectorXd::Constant(3, 0.001);
   double seconds = 0.0;
-  SharedEvaluationCallback callback(&term, &k, &seconds);
+  SharedEvaluationCallback callback({&term}, &k, &seconds);
   callback.PrepareForEvaluation(false, true);
   callback.PrepareForEvaluation(true, false);
   callback.PrepareForEvaluation(true, true);
@@ -510,17 +516,17 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
   CostScene scene(similarity, overlap);
   FrameEnergy& energy = scene.energy;
   const Eigen::VectorXd& k = scene.k;
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   // Prepared as in a solve; the full blocks then need the residuals: the paper's term, whose
   // blocks mix one parameter and several, has them from the callback too.
   Eigen::VectorXd point = k;
   double seconds = 0.0;
-  SharedEvaluationCallback callback(&term, &point, &seconds);
+  SharedEvaluationCallback callback({&term}, &point, &seconds);
   callback.PrepareForEvaluation(true, true);
   if (similarity != "paper") term.PrepareResiduals(k, true);
   for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
-    const SimilarityBlockCost full(term, b);
-    const ReducedSimilarityBlockCost reduced(term, b);
+    const DataBlockCost full(term, b);
+    const ReducedDataBlockCost reduced(term, term.block_summaries(), b);
     const int p = static_cast<int>(full.parameter_block_sizes().size());
     ASSERT_EQ(reduced.parameter_block_sizes().size(), static_cast<size_t>(p));
     EXPECT_EQ(reduced.num_residuals(), p == 1 ? 2 : std::min(full.num_residuals(), p + 1));
@@ -561,17 +567,25 @@ TEST_P(CeresCostTest, ReducedBlocksKeepCostGradientAndGaussNewtonMatrix) {
 TEST_P(CeresCostTest, BlockSummariesAreThoseOfTheResiduals) {
   const auto [similarity, overlap] = GetParam();
   CostScene scene(similarity, overlap);
-  SimilarityTerm& term = scene.energy.similarity();
-  term.SimilarityTerm::PrepareBlockSummaries(scene.k);
-  std::vector<SimilarityTerm::BlockSummary> expected;
+  DataTerm& term = scene.energy.data_term(0);
+  ASSERT_NE(term.block_summaries(), nullptr);
+  // The general means (SummarisedDataTerm's), from the residuals and Jacobians.
+  term.PrepareResiduals(scene.k, true);
+  std::vector<BlockSummary> expected;
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
-  for (int b = 0; b < num_blocks; ++b) expected.push_back(term.BlockSummaryOf(b));
-  term.PrepareBlockSummaries(scene.k);
+  for (int b = 0; b < num_blocks; ++b) {
+    const DataTerm::ResidualBlock& block = term.residual_blocks()[b];
+    std::vector<double> r(block.num_residuals), jacobian(block.num_residuals);
+    if (block.parameters.size() == 1) term.BlockResiduals(b, r.data(), jacobian.data());
+    expected.push_back(
+        SummarisedDataTerm::Summarise(r.data(), jacobian.data(), block.num_residuals));
+  }
+  term.block_summaries()->PrepareBlockSummaries(scene.k);
   int single = 0;
   for (int b = 0; b < num_blocks; ++b) {
     if (term.residual_blocks()[b].parameters.size() != 1) continue;
     ++single;
-    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    const BlockSummary& summary = term.block_summaries()->BlockSummaryOf(b);
     const double tolerance = 1e-12 * (1.0 + expected[b].squared_norm + expected[b].curvature);
     EXPECT_NEAR(summary.squared_norm, expected[b].squared_norm, tolerance) << "block " << b;
     EXPECT_NEAR(summary.gradient, expected[b].gradient, tolerance) << "block " << b;
@@ -588,11 +602,11 @@ TEST_P(CeresCostTest, BlockSummariesAreThoseOfTheResiduals) {
 TEST_P(CeresCostTest, SecantBlocksKeepCostAndGradientAndModelTheSecant) {
   const auto [similarity, overlap] = GetParam();
   CostScene scene(similarity, overlap);
-  SimilarityTerm& term = scene.energy.similarity();
+  DataTerm& term = scene.energy.data_term(0);
   const int num_blocks = static_cast<int>(term.residual_blocks().size());
-  std::vector<std::unique_ptr<ReducedSimilarityBlockCost>> costs;
+  std::vector<std::unique_ptr<ReducedDataBlockCost>> costs;
   for (int b = 0; b < num_blocks; ++b) {
-    costs.push_back(std::make_unique<ReducedSimilarityBlockCost>(term, b, true));
+    costs.push_back(std::make_unique<ReducedDataBlockCost>(term, term.block_summaries(), b, true));
   }
   // Block b's residuals and its Jacobian's one entry at k, with k_s taken from k.
   auto evaluate = [&](int b, const Eigen::VectorXd& k, Eigen::Vector2d* r) {
@@ -604,7 +618,7 @@ TEST_P(CeresCostTest, SecantBlocksKeepCostAndGradientAndModelTheSecant) {
     EXPECT_EQ(jacobian[1], 0.0);
     return jacobian[0];
   };
-  term.PrepareBlockSummaries(scene.k);
+  term.block_summaries()->PrepareBlockSummaries(scene.k);
   std::vector<double> first_gradient(num_blocks);
   int single = 0, lowered = 0, raised = 0;
   for (int b = 0; b < num_blocks; ++b) {
@@ -612,27 +626,26 @@ TEST_P(CeresCostTest, SecantBlocksKeepCostAndGradientAndModelTheSecant) {
     ++single;
     Eigen::Vector2d r;
     const double length = evaluate(b, scene.k, &r);
-    EXPECT_NEAR(length * length, term.BlockSummaryOf(b).curvature,
-                1e-12 * (1.0 + term.BlockSummaryOf(b).curvature))
+    EXPECT_NEAR(length * length, term.block_summaries()->BlockSummaryOf(b).curvature,
+                1e-12 * (1.0 + term.block_summaries()->BlockSummaryOf(b).curvature))
         << "block " << b;
-    first_gradient[b] = term.BlockSummaryOf(b).gradient;
+    first_gradient[b] = term.block_summaries()->BlockSummaryOf(b).gradient;
   }
   if (single == 0) return;
   const double step = 0.0003;
   const Eigen::VectorXd moved = scene.k.array() + step;
-  term.PrepareBlockSummaries(moved);
+  term.block_summaries()->PrepareBlockSummaries(moved);
   for (int b = 0; b < num_blocks; ++b) {
     if (term.residual_blocks()[b].parameters.size() != 1) continue;
-    const SimilarityTerm::BlockSummary& summary = term.BlockSummaryOf(b);
+    const BlockSummary& summary = term.block_summaries()->BlockSummaryOf(b);
     Eigen::Vector2d r;
     const double length = evaluate(b, moved, &r);
     const double tolerance = 1e-9 * (1.0 + summary.squared_norm + summary.curvature);
     EXPECT_NEAR(r.squaredNorm(), summary.squared_norm, tolerance) << "block " << b;
     EXPECT_NEAR(length * r[0], summary.gradient, tolerance) << "block " << b;
     const double secant = (summary.gradient - first_gradient[b]) / step;
-    double expected =
-        std::clamp(secant, ReducedSimilarityBlockCost::kMinSecantFactor * summary.curvature,
-                   ReducedSimilarityBlockCost::kMaxSecantFactor * summary.curvature);
+    double expected = std::clamp(secant, ReducedDataBlockCost::kMinSecantFactor * summary.curvature,
+                                 ReducedDataBlockCost::kMaxSecantFactor * summary.curvature);
     if (summary.squared_norm > 0.0) {
       expected = std::max(expected, summary.gradient * summary.gradient / summary.squared_norm);
     }
@@ -651,7 +664,7 @@ TEST_P(CeresCostTest, LeastSquaresTermsAgreeWithTheirResiduals) {
   CostScene scene(similarity, overlap);
   FrameEnergy& energy = scene.energy;
   const Eigen::VectorXd& k = scene.k;
-  SimilarityTerm& term = energy.similarity();
+  DataTerm& term = energy.data_term(0);
   EXPECT_EQ(term.IsLeastSquares(), similarity != "paper");
   if (!term.IsLeastSquares()) return;
   double e = 0.0, cost = 0.0;
@@ -662,7 +675,7 @@ TEST_P(CeresCostTest, LeastSquaresTermsAgreeWithTheirResiduals) {
 
 // A term of one block with fixed residuals and Jacobian, for the reduction of a block of several
 // parameters (QR), which no similarity of the product needs today.
-class FixedBlockTerm : public SimilarityTerm {
+class FixedBlockTerm : public DataTerm {
  public:
   FixedBlockTerm(Eigen::VectorXd r, Eigen::MatrixXd jacobian)
       : r_(std::move(r)), jacobian_(std::move(jacobian)) {
@@ -691,7 +704,7 @@ class FixedBlockTerm : public SimilarityTerm {
 TEST(CeresCostTest, AReducedBlockOfSeveralParametersKeepsTheLinearModel) {
   std::srand(7);
   const FixedBlockTerm term(Eigen::VectorXd::Random(12), Eigen::MatrixXd::Random(12, 3));
-  const ReducedSimilarityBlockCost reduced(term, 0);
+  const ReducedDataBlockCost reduced(term, nullptr, 0);
   ASSERT_EQ(reduced.num_residuals(), 4);
   Eigen::VectorXd r(4);
   std::vector<Eigen::VectorXd> columns(3, Eigen::VectorXd(4));

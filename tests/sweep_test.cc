@@ -23,7 +23,7 @@ TEST(SweepTest, GaussiansNoBlockReachesStartOnTheCoarseMesh) {
   const EnergyScene scene = MakeEnergyScene({0.3}, 2, 7);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      SweepEnergyOptions(SimilarityType::kConsensus));
-  ASSERT_TRUE(energy.similarity().residual_blocks().empty());
+  ASSERT_TRUE(energy.data_term(0).residual_blocks().empty());
   const Eigen::VectorXd k = SweepInitialization(&energy, SweepOptions());
   ASSERT_EQ(k.size(), energy.num_parameters());
   EXPECT_TRUE(k.isZero(0.0)) << k.transpose();
@@ -37,7 +37,7 @@ TEST(SweepTest, StartsLieWithinTheSweptRange) {
   for (const SimilarityType similarity : {SimilarityType::kPaper, SimilarityType::kConsensus}) {
     const EnergyOptions options = SweepEnergyOptions(similarity);
     FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
-    ASSERT_FALSE(energy.similarity().residual_blocks().empty());
+    ASSERT_FALSE(energy.data_term(0).residual_blocks().empty());
     SweepOptions sweep;
     sweep.samples = 9;
     const Eigen::VectorXd k = SweepInitialization(&energy, sweep);

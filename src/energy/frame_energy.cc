@@ -52,19 +52,20 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
       samples_(std::move(samples)),
       sample_cameras_(samples_.size() > 0 ? cameras : std::vector<CameraInput>()),
       views_(BuildViews(surface_, cameras, options_, samples_.size() > 0)),
-      similarity_(internal::MakeSimilarity(surface_, views_, neighbourhoods, samples_,
-                                           sample_cameras_, options_)),
       regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
-                   options_.RegUnitScale()) {
+                   options_.RegUnitScale()),
+      data_terms_(internal::MakeDataTerms(
+          {surface_, views_, neighbourhoods, regularizer_, samples_, sample_cameras_, options_})) {
   confidence_ = Confidence(surface_, PlainCloth(surface_, regularizer_, options_));
   const TermContext context{surface_, options_, regularizer_, confidence_,
                             [this] { return TypicalDataCurvature(); }};
   quadratic_terms_ = internal::MakeQuadraticTerms(context);
   for (const auto& term : quadratic_terms_) term->AddDifferences(&differences_);
   GatherPulls();
+  const bool keep_pair_lists = ReadsPairLists();
   for (EnergyView& view : views_) {
     num_pairs_ += view.pairs.num_pairs();
-    if (similarity_->ReadsPairLists()) continue;
+    if (keep_pair_lists) continue;
     std::vector<int>().swap(view.pairs.image_ids);
     std::vector<float>().swap(view.pairs.color_weights);
     view.image = nullptr;  // Without the ids nothing leads to the image Gaussians.
@@ -75,10 +76,59 @@ double FrameEnergy::TypicalDataCurvature() {
   // Measured once, at the input surface, so that every pull in its units is a fixed quadratic:
   // the solvers see one energy throughout.
   if (typical_data_curvature_ < 0.0) {
-    typical_data_curvature_ =
-        MedianOfPositive(DataCurvature(similarity_.get(), Eigen::VectorXd::Zero(surface_.size())));
+    const Eigen::VectorXd input = Eigen::VectorXd::Zero(surface_.size());
+    Eigen::VectorXd curvature = input;
+    for (size_t i = 0; i < data_terms_.size(); ++i) {
+      if (i == 0) {
+        curvature = DataCurvature(data_terms_[i].get(), input);
+      } else {
+        curvature += DataCurvature(data_terms_[i].get(), input);
+      }
+    }
+    typical_data_curvature_ = MedianOfPositive(curvature);
   }
   return typical_data_curvature_;
+}
+
+Eigen::VectorXd FrameEnergy::UnknownsAtVertices(const Eigen::VectorXd& per_vertex) const {
+  const std::vector<int>& ids = surface_.vertex_ids;
+  Eigen::VectorXd unknowns(static_cast<Eigen::Index>(ids.size()));
+  for (size_t s = 0; s < ids.size(); ++s) unknowns[s] = per_vertex[ids[s]];
+  return unknowns;
+}
+
+void FrameEnergy::AddDataTerm(std::unique_ptr<DataTerm> term) {
+  Require(term != nullptr, "FrameEnergy::AddDataTerm", "no term given");
+  data_terms_.push_back(std::move(term));
+}
+
+bool FrameEnergy::IsLeastSquares() const {
+  for (const auto& term : data_terms_) {
+    if (!term->IsLeastSquares()) return false;
+  }
+  return true;
+}
+
+bool FrameEnergy::ReadsPairLists() const {
+  for (const auto& term : data_terms_) {
+    if (term->ReadsPairLists()) return true;
+  }
+  return false;
+}
+
+bool FrameEnergy::HasPassHooks() const {
+  for (const auto& term : data_terms_) {
+    if (term->pass_hook() != nullptr) return true;
+  }
+  return false;
+}
+
+void FrameEnergy::EndOfPass(const Eigen::VectorXd& k) {
+  Require(k.size() == surface_.size(), "FrameEnergy::EndOfPass",
+          "one displacement per surface Gaussian expected");
+  for (const auto& term : data_terms_) {
+    if (PassHook* hook = term->pass_hook()) hook->EndOfPass(k);
+  }
 }
 
 void FrameEnergy::GatherPulls() {
@@ -110,19 +160,29 @@ Eigen::Matrix3Xd FrameEnergy::SampleAppearance(const Eigen::VectorXd& k) const {
 
 long FrameEnergy::num_pairs() const { return num_pairs_; }
 
-double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient,
-                             double* similarity, double* quadratic) const {
-  Eigen::VectorXd similarity_gradient, difference_gradient;
-  const double e_sim = similarity_->Evaluate(k, gradient ? &similarity_gradient : nullptr);
+double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient, double* data,
+                             double* quadratic) const {
+  // The terms' sum starts from the first term's value and gradient themselves, not from zero.
+  Eigen::VectorXd data_gradient, term_gradient, difference_gradient;
+  double e_data = 0.0;
+  for (size_t i = 0; i < data_terms_.size(); ++i) {
+    Eigen::VectorXd* into = gradient == nullptr ? nullptr
+                            : i == 0            ? &data_gradient
+                                                : &term_gradient;
+    const double value = data_terms_[i]->Evaluate(k, into);
+    e_data = i == 0 ? value : e_data + value;
+    if (i > 0 && gradient != nullptr) data_gradient += term_gradient;
+  }
+  if (data_terms_.empty()) data_gradient = Eigen::VectorXd::Zero(k.size());
   const double e_differences = DifferenceEnergy(k, gradient ? &difference_gradient : nullptr);
   const double e_pulls = PullEnergy(k);
   if (gradient != nullptr) {
-    *gradient = similarity_gradient - difference_gradient -
-                pulls_.curvature().cwiseProduct(k - pulls_.target());
+    *gradient =
+        data_gradient - difference_gradient - pulls_.curvature().cwiseProduct(k - pulls_.target());
   }
-  if (similarity != nullptr) *similarity = e_sim;
+  if (data != nullptr) *data = e_data;
   if (quadratic != nullptr) *quadratic = e_differences + e_pulls;
-  return e_sim - e_differences - e_pulls;
+  return e_data - e_differences - e_pulls;
 }
 
 }  // namespace finecap

@@ -31,28 +31,37 @@ std::vector<std::vector<int>> SurfaceRings(const SurfaceGaussians& surface,
   return patches;
 }
 
-}  // namespace
-
-std::unique_ptr<SimilarityTerm> MakeSimilarity(const SurfaceGaussians& surface,
-                                               const std::vector<EnergyView>& views,
-                                               const VertexNeighbourhoods& neighbourhoods,
-                                               const SurfaceSamples& samples,
-                                               const std::vector<CameraInput>& sample_cameras,
-                                               const EnergyOptions& options) {
+// The similarity of options.similarity.
+std::unique_ptr<DataTerm> MakeSimilarity(const DataTermContext& context) {
+  const EnergyOptions& options = context.options;
   const OverlapForm form = options.overlap;
-  if (samples.size() > 0) {
+  if (context.samples.size() > 0) {
     Require(options.similarity == SimilarityType::kConsensus, "energy.similarity",
             "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
-    return std::make_unique<PixelConsensusSimilarity>(samples, sample_cameras, options.consensus);
+    auto term = std::make_unique<PixelConsensusSimilarity>(context.samples, context.sample_cameras,
+                                                           options.consensus);
+    term->SmoothShapesOver(&context.neighbours);
+    return term;
   }
   if (options.similarity == SimilarityType::kPaper)
-    return std::make_unique<PaperSimilarity>(surface, views, form);
+    return std::make_unique<PaperSimilarity>(context.surface, context.views, form);
   if (options.similarity == SimilarityType::kConsensus) {
-    return std::make_unique<ConsensusSimilarity>(
-        surface, views, SurfaceRings(surface, neighbourhoods, options.consensus.patch_rings), form,
+    auto term = std::make_unique<ConsensusSimilarity>(
+        context.surface, context.views,
+        SurfaceRings(context.surface, context.neighbourhoods, options.consensus.patch_rings), form,
         options.k_max, options.reach_sigmas, options.consensus);
+    term->SmoothShapesOver(&context.neighbours);
+    return term;
   }
-  return std::make_unique<SurfaceColorSimilarity>(surface, views, form);
+  return std::make_unique<SurfaceColorSimilarity>(context.surface, context.views, form);
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<DataTerm>> MakeDataTerms(const DataTermContext& context) {
+  std::vector<std::unique_ptr<DataTerm>> terms;
+  terms.push_back(MakeSimilarity(context));
+  return terms;
 }
 
 std::vector<std::unique_ptr<QuadraticTerm>> MakeQuadraticTerms(const TermContext& context) {

@@ -63,12 +63,9 @@ EnergyProbe ProbeEnergyAlongTruth(Capture* capture, int frame, const SequenceMod
 
   const Eigen::VectorXd truth_all =
       TrueFineGroundTruth(*capture, model, input.coarse, frame).k_true;
-  Eigen::VectorXd truth(energy.num_parameters());
-  for (int s = 0; s < truth.size(); ++s) {
-    const double k = truth_all[energy.surface().vertex_ids[s]];
-    truth[s] =
-        std::isfinite(k) ? std::clamp(k, -energy.options().k_max, energy.options().k_max) : 0.0;
-  }
+  const double bound = energy.layout().bound;
+  Eigen::VectorXd truth = energy.UnknownsAtVertices(truth_all);
+  for (double& k : truth) k = std::isfinite(k) ? std::clamp(k, -bound, bound) : 0.0;
   EnergyProbe probe;
   probe.frame = capture->frame_name(frame);
   probe.similarity = energy.options().similarity;

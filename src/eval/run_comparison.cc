@@ -24,13 +24,11 @@ double PaperSimilarityAtResult(const SequenceModel& model, const ReferenceColors
   RefineOptions options = refine;
   options.energy = WithThePapersSimilarity(options.energy);
   const PreparedFrame frame = PrepareFrame(model, colors, input, options);
-  const std::vector<int>& ids = frame.energy->surface().vertex_ids;
-  const Eigen::VectorXd solved = SolvedDisplacement(k_fine, stats.kept_input, options);
-  Eigen::VectorXd k(ids.size());
-  for (size_t s = 0; s < ids.size(); ++s) k[s] = solved[ids[s]];
-  double similarity = 0.0;
-  frame.energy->Evaluate(k, nullptr, &similarity);
-  return similarity;
+  const Eigen::VectorXd k =
+      frame.energy->UnknownsAtVertices(SolvedDisplacement(k_fine, stats.kept_input, options));
+  double data = 0.0;  // E_data: the paper's similarity, its one data term.
+  frame.energy->Evaluate(k, nullptr, &data);
+  return data;
 }
 
 }  // namespace

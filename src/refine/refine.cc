@@ -229,8 +229,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
   }
   frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
                                                EnergyOptionsAt(options));
-  if (!frame.energy->similarity().ReadsPairLists())
-    std::vector<ImageGaussians>().swap(frame.images);
+  if (!frame.energy->ReadsPairLists()) std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
   return frame;
 }
@@ -294,29 +293,19 @@ bool ReadsImagesAfterPreparation(const RefineOptions& options) {
 
 namespace {
 
-// Shapes the patches of `energy` like the surface `k` (when its similarity compares patches): the
-// window's displacement, not each member's noise about it (ConsensusOptions).
-void ShapePatchesLike(const Eigen::VectorXd& k, const RefineOptions& options, FrameEnergy* energy) {
-  SimilarityTerm& similarity = energy->similarity();
-  if (!similarity.ShapesPatches()) return;
-  Eigen::MatrixXd shape = k;
-  energy->regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
-                                              &shape);
-  similarity.SetPatchShape(shape.col(0));
-}
-
-// Solve, and for a similarity of patches the further passes with patches shaped like the surface
-// found so far. The summary's start values are those of the last pass's energy at `*k`'s start,
-// so that `worse` compares the frame by the energy it ended with.
+// Solve, and for an energy whose terms change between passes (PassHook: the consensus' patches
+// shaped like the surface found so far) the further passes. The summary's start values are those
+// of the last pass's energy at `*k`'s start, so that `worse` compares the frame by the energy it
+// ended with.
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
   const int passes = options.energy.consensus.passes;
   const Eigen::VectorXd start = *k;
   FrameSolver solver(energy, options.solver, workspace);  // One Ceres problem for all the passes.
   SolverSummary summary = solver.Solve(k);
-  if (!energy->similarity().ShapesPatches()) return summary;
+  if (!energy->HasPassHooks()) return summary;
   for (int pass = 1; pass < passes; ++pass) {
-    ShapePatchesLike(*k, options, energy);
+    energy->EndOfPass(*k);
     const SolverSummary more = solver.Solve(k);
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;
@@ -336,10 +325,7 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
 // of `energy` that read it.
 void TakeTheFrameBefore(const FrameInput& input, FrameEnergy* energy) {
   if (input.frame_before_k.size() == 0) return;
-  const std::vector<int>& ids = energy->surface().vertex_ids;
-  Eigen::VectorXd k_before(static_cast<Eigen::Index>(ids.size()));
-  for (size_t s = 0; s < ids.size(); ++s) k_before[s] = input.frame_before_k[ids[s]];
-  energy->TakeFrameBefore(k_before);
+  energy->TakeFrameBefore(energy->UnknownsAtVertices(input.frame_before_k));
 }
 
 // Where the solve of a prepared frame starts: one k per surface Gaussian of its energy.
@@ -422,7 +408,8 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     const double seconds = frame.seconds;
     PrepareDetailEnergy(model, input, options, &frame);
     result.seconds_preparation += frame.seconds - seconds;
-    ShapePatchesLike(k, options, frame.energy.get());
+    // The solve of the Gaussians' stage was this energy's first pass.
+    frame.energy->EndOfPass(k);
     TakeTheFrameBefore(input, frame.energy.get());
     SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
     EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,

@@ -8,15 +8,14 @@
 
 #include <Eigen/QR>
 
+#include "finecap/util/error.h"
 #include "solvers/solvers_internal.h"
 
 namespace finecap {
 
-SharedEvaluationCallback::SharedEvaluationCallback(SimilarityTerm* term, const Eigen::VectorXd* k,
-                                                   double* seconds)
-    : k_(k), seconds_(seconds) {
-  Rebind(term);
-}
+SharedEvaluationCallback::SharedEvaluationCallback(std::vector<DataTerm*> terms,
+                                                   const Eigen::VectorXd* k, double* seconds)
+    : terms_(std::move(terms)), k_(k), seconds_(seconds) {}
 
 void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
                                                     bool new_evaluation_point) {
@@ -30,10 +29,12 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
   if (!new_point && (!rows_wanted || rows_prepared_)) return;
   const internal::Stopwatch clock;
   if (new_point) {
-    if (summaries_only_) {
-      term_->PrepareBlockSummaries(*k_);
-    } else {
-      term_->SimilarityTerm::PrepareBlockSummaries(*k_);
+    for (DataTerm* term : terms_) {
+      if (BlockSummaries* summaries = term->block_summaries()) {
+        summaries->PrepareBlockSummaries(*k_);
+      } else {
+        term->PrepareResiduals(*k_, true);
+      }
     }
     prepared_ = *k_;
     rows_prepared_ = false;
@@ -45,24 +46,25 @@ void SharedEvaluationCallback::PrepareForEvaluation(bool evaluate_jacobians,
   *seconds_ += clock.Seconds();
 }
 
-void SharedEvaluationCallback::Rebind(SimilarityTerm* term) {
-  term_ = term;
-  summaries_only_ = true;
-  for (const SimilarityTerm::ResidualBlock& block : term->residual_blocks()) {
-    if (block.parameters.size() != 1) summaries_only_ = false;
-  }
+void SharedEvaluationCallback::Rebind(std::vector<DataTerm*> terms) {
+  terms_ = std::move(terms);
   Forget();
 }
 
-SimilarityBlockCost::SimilarityBlockCost(const SimilarityTerm& term, int block)
-    : term_(term), block_(block) {
-  const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
+std::vector<DataTerm*> DataTermsOf(FrameEnergy* energy) {
+  std::vector<DataTerm*> terms;
+  for (int i = 0; i < energy->num_data_terms(); ++i) terms.push_back(&energy->data_term(i));
+  return terms;
+}
+
+DataBlockCost::DataBlockCost(const DataTerm& term, int block) : term_(term), block_(block) {
+  const DataTerm::ResidualBlock& info = term.residual_blocks()[block];
   set_num_residuals(info.num_residuals);
   mutable_parameter_block_sizes()->assign(info.parameters.size(), 1);
 }
 
-bool SimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* residuals,
-                                   double** jacobians) const {
+bool DataBlockCost::Evaluate(double const* const* /*parameters*/, double* residuals,
+                             double** jacobians) const {
   if (jacobians == nullptr) {
     term_.BlockResiduals(block_, residuals, nullptr);
     return true;
@@ -80,22 +82,24 @@ bool SimilarityBlockCost::Evaluate(double const* const* /*parameters*/, double* 
   return true;
 }
 
-ReducedSimilarityBlockCost::ReducedSimilarityBlockCost(const SimilarityTerm& term, int block,
-                                                       bool secant)
-    : term_(term), block_(block), full_(term, block), secant_(secant) {
-  const SimilarityTerm::ResidualBlock& info = term.residual_blocks()[block];
+ReducedDataBlockCost::ReducedDataBlockCost(const DataTerm& term, const BlockSummaries* summaries,
+                                           int block, bool secant)
+    : term_(term), summaries_(summaries), block_(block), full_(term, block), secant_(secant) {
+  const DataTerm::ResidualBlock& info = term.residual_blocks()[block];
   num_full_residuals_ = info.num_residuals;
   const int num_parameters = static_cast<int>(info.parameters.size());
+  Require(num_parameters > 1 || summaries != nullptr, "ReducedDataBlockCost",
+          "a block of one parameter is reduced from its term's summaries");
   set_num_residuals(num_parameters == 1 ? 2 : std::min(num_full_residuals_, num_parameters + 1));
   mutable_parameter_block_sizes()->assign(num_parameters, 1);
 }
 
-bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, double* residuals,
-                                          double** jacobians) const {
+bool ReducedDataBlockCost::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
   const int p = static_cast<int>(parameter_block_sizes().size());
   if (p == 1) {
-    ReducedOneParameterRows(term_.BlockSummaryOf(block_), parameters[0][0], secant_, &curvature_,
-                            residuals, jacobians);
+    ReducedOneParameterRows(summaries_->BlockSummaryOf(block_), parameters[0][0], secant_,
+                            &curvature_, residuals, jacobians);
     return true;
   }
   const int m = num_full_residuals_;
@@ -126,7 +130,7 @@ bool ReducedSimilarityBlockCost::Evaluate(double const* const* parameters, doubl
   return true;
 }
 
-double BlockCurvature::At(double k, const SimilarityTerm::BlockSummary& summary, bool secant) {
+double BlockCurvature::At(double k, const BlockSummary& summary, bool secant) {
   if (!secant) return summary.curvature;
   // Steps shorter than this (metres) are rounding: their secant is noise.
   constexpr double kMinSpan = 1e-9;
@@ -149,7 +153,7 @@ double BlockCurvature::At(double k, const SimilarityTerm::BlockSummary& summary,
   return curvature;
 }
 
-void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double k, bool secant,
+void ReducedOneParameterRows(const BlockSummary& summary, double k, bool secant,
                              BlockCurvature* curvature, double* residuals, double** jacobians) {
   if (jacobians == nullptr) {
     residuals[0] = std::sqrt(summary.squared_norm);
@@ -167,17 +171,16 @@ void ReducedOneParameterRows(const SimilarityTerm::BlockSummary& summary, double
   }
 }
 
-IsolatedSimilarityBlockCost::IsolatedSimilarityBlockCost(SimilarityTerm* term, int block,
-                                                         const Eigen::VectorXd& k)
-    : SimilarityBlockCost(*term, block), mutable_term_(term), k_(k) {}
+IsolatedDataBlockCost::IsolatedDataBlockCost(DataTerm* term, int block, const Eigen::VectorXd& k)
+    : DataBlockCost(*term, block), mutable_term_(term), k_(k) {}
 
-bool IsolatedSimilarityBlockCost::Evaluate(double const* const* parameters, double* residuals,
-                                           double** jacobians) const {
+bool IsolatedDataBlockCost::Evaluate(double const* const* parameters, double* residuals,
+                                     double** jacobians) const {
   Eigen::VectorXd k = k_;
   const std::vector<int>& ids = term_.residual_blocks()[block_].parameters;
   for (size_t p = 0; p < ids.size(); ++p) k[ids[p]] = parameters[p][0];
   mutable_term_->PrepareResiduals(k, jacobians != nullptr);
-  return SimilarityBlockCost::Evaluate(parameters, residuals, jacobians);
+  return DataBlockCost::Evaluate(parameters, residuals, jacobians);
 }
 
 SmoothnessBlockCost::SmoothnessBlockCost(double prior_root, std::vector<Neighbour> neighbours,
@@ -225,20 +228,51 @@ void SmoothnessBlockCost::Rows(double prior_root, double prior_target, const Nei
   }
 }
 
-int GaussianModelRows::Add(int parameter, int block, double prior, double target) {
+int GaussianModelRows::Add(int parameter, double prior, double target) {
   Gaussian gaussian;
   gaussian.parameter = parameter;
-  gaussian.block = block;
+  gaussian.first_block = static_cast<int>(blocks_.size());
   gaussian.prior = prior;
   gaussian.target = target;
   gaussians_.push_back(gaussian);
   return size() - 1;
 }
 
+void GaussianModelRows::AddBlock(int i, const BlockSummaries* summaries, int block) {
+  Gaussian& gaussian = gaussians_[i];
+  if (gaussian.num_blocks == 0) gaussian.first_block = static_cast<int>(blocks_.size());
+  Require(gaussian.first_block + gaussian.num_blocks == static_cast<int>(blocks_.size()),
+          "GaussianModelRows::AddBlock", "blocks are added Gaussian after Gaussian");
+  blocks_.push_back({summaries, block});
+  ++gaussian.num_blocks;
+}
+
+void GaussianModelRows::ClearBlocks() {
+  blocks_.clear();
+  for (Gaussian& gaussian : gaussians_) gaussian.num_blocks = 0;
+}
+
+BlockSummary GaussianModelRows::Summary(int i) const {
+  const Gaussian& gaussian = gaussians_[i];
+  if (gaussian.num_blocks == 0) return {};
+  // The first block's summary itself, then the others added to it.
+  const Block* block = &blocks_[gaussian.first_block];
+  BlockSummary sum = block->summaries->BlockSummaryOf(block->block);
+  for (int j = 1; j < gaussian.num_blocks; ++j) {
+    ++block;
+    const BlockSummary& more = block->summaries->BlockSummaryOf(block->block);
+    sum.squared_norm += more.squared_norm;
+    sum.gradient += more.gradient;
+    sum.curvature += more.curvature;
+  }
+  return sum;
+}
+
 void GaussianModelRows::Prepare(const Eigen::VectorXd& k) {
   double remainder = 0.0;
-  for (Gaussian& gaussian : gaussians_) {
-    const SimilarityTerm::BlockSummary& summary = SummaryOf(gaussian);
+  for (int i = 0; i < size(); ++i) {
+    Gaussian& gaussian = gaussians_[i];
+    const BlockSummary summary = Summary(i);
     const double k_s = k[gaussian.parameter];
     const double from_target = k_s - gaussian.target;
     const double curvature = gaussian.curvature.At(k_s, summary, secant_) + gaussian.prior;
@@ -261,7 +295,7 @@ void GaussianModelRows::ForgetHistories() {
 double GaussianModelRows::Norm(int i, double k) const {
   const Gaussian& gaussian = gaussians_[i];
   const double from_target = k - gaussian.target;
-  return std::sqrt(SummaryOf(gaussian).squared_norm + gaussian.prior * from_target * from_target);
+  return std::sqrt(Summary(i).squared_norm + gaussian.prior * from_target * from_target);
 }
 
 SurfaceGaussianCost::SurfaceGaussianCost(const GaussianModelRows& rows, int i,
@@ -354,27 +388,30 @@ SmoothnessRows SmoothnessRowsOfEachGaussian(const FrameEnergy& energy, int num_g
 
 }  // namespace
 
-void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secant, Layout layout,
+void FrameCostFunctions::AddResidualBlocks(FrameEnergy* energy, bool secant, Layout layout,
                                            Eigen::VectorXd* k, ceres::Problem* problem) {
-  const double k_max = energy.layout().bound;
+  const double k_max = energy->layout().bound;
   const int num_gaussians = static_cast<int>(k->size());
   for (int s = 0; s < num_gaussians; ++s) {
     problem->AddParameterBlock(&(*k)[s], 1);
     problem->SetParameterLowerBound(&(*k)[s], 0, -k_max);
     problem->SetParameterUpperBound(&(*k)[s], 0, k_max);
   }
-  const std::vector<int> merged =
-      AddSimilarityBlocks(energy.similarity(), secant, layout, k, problem);
-  SmoothnessRows rows = SmoothnessRowsOfEachGaussian(energy, num_gaussians);
+  const int num_terms = energy->num_data_terms();
+  std::vector<std::vector<int>> merged(num_terms);
+  for (int t = 0; t < num_terms; ++t) {
+    merged[t] = AddDataBlocks(&energy->data_term(t), secant, layout, k, problem);
+  }
+  SmoothnessRows rows = SmoothnessRowsOfEachGaussian(*energy, num_gaussians);
   neighbours_ = std::move(rows.neighbours);
   const bool per_gaussian = layout == Layout::kPerGaussian;
-  rebindable_ = per_gaussian && similarity_.empty() && num_gaussians > 0;
+  rebindable_ = per_gaussian && reduced_.empty() && full_.empty() && num_gaussians > 0;
   k_max_ = k_max;
   neighbour_begin_ = rows.begin;
   neighbour_other_ = rows.other;
-  model_rows_ = std::make_unique<GaussianModelRows>(energy.similarity(), secant);
-  const Eigen::VectorXd& prior = energy.pull_curvature();
-  const Eigen::VectorXd& target = energy.pull_target();
+  model_rows_ = std::make_unique<GaussianModelRows>(secant);
+  const Eigen::VectorXd& prior = energy->pull_curvature();
+  const Eigen::VectorXd& target = energy->pull_target();
   std::vector<double*> parameter_blocks;
   for (int s = 0; s < num_gaussians; ++s) {
     if (!per_gaussian && rows.empty(s)) continue;
@@ -382,7 +419,11 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
     const int num_free = static_cast<int>(parameter_blocks.size()) - 1;
     const SmoothnessBlockCost::Neighbour* neighbours = neighbours_.data() + rows.begin[s];
     if (per_gaussian) {
-      const int row = model_rows_->Add(s, merged[s], std::max(0.0, prior[s]), target[s]);
+      const int row = model_rows_->Add(s, std::max(0.0, prior[s]), target[s]);
+      for (int t = 0; t < num_terms; ++t) {
+        if (merged[t][s] < 0) continue;
+        model_rows_->AddBlock(row, energy->data_term(t).block_summaries(), merged[t][s]);
+      }
       surface_gaussians_.emplace_back(*model_rows_, row, neighbours, rows.num_neighbours(s),
                                       num_free);
       problem->AddResidualBlock(&surface_gaussians_.back(), nullptr, parameter_blocks);
@@ -402,52 +443,74 @@ void FrameCostFunctions::AddResidualBlocks(const FrameEnergy& energy, bool secan
   problem->AddResidualBlock(remainder_.get(), nullptr, &(*k)[0]);
 }
 
-bool FrameCostFunctions::Rebind(const FrameEnergy& energy) {
-  const SimilarityTerm& term = energy.similarity();
-  const int num_gaussians = model_rows_ != nullptr ? model_rows_->size() : 0;
-  if (!rebindable_ || energy.num_parameters() != num_gaussians || energy.layout().bound != k_max_) {
-    return false;
-  }
+std::vector<int> FrameCostFunctions::OneBlockPerGaussian(DataTerm* term, int num_gaussians) {
+  if (term->block_summaries() == nullptr) return {};
   std::vector<int> block_of(num_gaussians, -1);
-  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
-    const std::vector<int>& parameters = term.residual_blocks()[b].parameters;
-    if (parameters.size() != 1 || block_of[parameters[0]] >= 0) return false;
+  for (int b = 0; b < static_cast<int>(term->residual_blocks().size()); ++b) {
+    const std::vector<int>& parameters = term->residual_blocks()[b].parameters;
+    if (parameters.size() != 1 || block_of[parameters[0]] >= 0) return {};
     block_of[parameters[0]] = b;
   }
-  SmoothnessRows rows = SmoothnessRowsOfEachGaussian(energy, num_gaussians);
+  return block_of;
+}
+
+bool FrameCostFunctions::Rebind(FrameEnergy* energy) {
+  const int num_gaussians = model_rows_ != nullptr ? model_rows_->size() : 0;
+  if (!rebindable_ || energy->num_parameters() != num_gaussians ||
+      energy->layout().bound != k_max_) {
+    return false;
+  }
+  const int num_terms = energy->num_data_terms();
+  std::vector<std::vector<int>> block_of(num_terms);
+  for (int t = 0; t < num_terms; ++t) {
+    block_of[t] = OneBlockPerGaussian(&energy->data_term(t), num_gaussians);
+    if (block_of[t].empty() && !energy->data_term(t).residual_blocks().empty()) return false;
+  }
+  SmoothnessRows rows = SmoothnessRowsOfEachGaussian(*energy, num_gaussians);
   if (rows.begin != neighbour_begin_ || rows.other != neighbour_other_) return false;
   // In place: every SurfaceGaussianCost holds its neighbours' address.
   std::copy(rows.neighbours.begin(), rows.neighbours.end(), neighbours_.begin());
-  model_rows_->Rebind(term);
-  const Eigen::VectorXd& prior = energy.pull_curvature();
-  const Eigen::VectorXd& target = energy.pull_target();
+  model_rows_->ClearBlocks();
+  const Eigen::VectorXd& prior = energy->pull_curvature();
+  const Eigen::VectorXd& target = energy->pull_target();
   for (int s = 0; s < num_gaussians; ++s) {
-    model_rows_->Set(s, block_of[s], std::max(0.0, prior[s]), target[s]);
+    model_rows_->Set(s, std::max(0.0, prior[s]), target[s]);
+    for (int t = 0; t < num_terms; ++t) {
+      if (block_of[t].empty() || block_of[t][s] < 0) continue;
+      model_rows_->AddBlock(s, energy->data_term(t).block_summaries(), block_of[t][s]);
+    }
   }
   return true;
 }
 
-std::vector<int> FrameCostFunctions::AddSimilarityBlocks(const SimilarityTerm& term, bool secant,
-                                                         Layout layout, Eigen::VectorXd* k,
-                                                         ceres::Problem* problem) {
+std::vector<int> FrameCostFunctions::AddDataBlocks(DataTerm* term, bool secant, Layout layout,
+                                                   Eigen::VectorXd* k, ceres::Problem* problem) {
+  const BlockSummaries* summaries = term->block_summaries();
   std::vector<int> merged(k->size(), -1);
   std::vector<double*> parameter_blocks;
-  for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
-    const std::vector<int>& parameters = term.residual_blocks()[b].parameters;
-    if (layout == Layout::kPerGaussian && parameters.size() == 1 && merged[parameters[0]] < 0) {
+  for (int b = 0; b < static_cast<int>(term->residual_blocks().size()); ++b) {
+    const std::vector<int>& parameters = term->residual_blocks()[b].parameters;
+    const bool one = parameters.size() == 1;
+    if (layout == Layout::kPerGaussian && one && summaries != nullptr &&
+        merged[parameters[0]] < 0) {
       merged[parameters[0]] = b;
       continue;
     }
     parameter_blocks.clear();
     for (int s : parameters) parameter_blocks.push_back(&(*k)[s]);
-    similarity_.emplace_back(term, b, secant);
-    problem->AddResidualBlock(&similarity_.back(), nullptr, parameter_blocks);
+    if (one && summaries == nullptr) {
+      full_.emplace_back(*term, b);
+      problem->AddResidualBlock(&full_.back(), nullptr, parameter_blocks);
+    } else {
+      reduced_.emplace_back(*term, summaries, b, secant);
+      problem->AddResidualBlock(&reduced_.back(), nullptr, parameter_blocks);
+    }
   }
   return merged;
 }
 
 void FrameCostFunctions::ForgetHistories() {
-  for (const ReducedSimilarityBlockCost& cost : similarity_) cost.ForgetHistory();
+  for (const ReducedDataBlockCost& cost : reduced_) cost.ForgetHistory();
   if (model_rows_ != nullptr) model_rows_->ForgetHistories();
 }
 

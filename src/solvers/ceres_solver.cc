@@ -70,20 +70,20 @@ CeresFrameProblem::CeresFrameProblem(FrameEnergy* energy, bool secant,
                                      FrameCostFunctions::Layout layout)
     : secant_(secant),
       state_(Eigen::VectorXd::Zero(energy->num_parameters())),
-      shared_(&energy->similarity(), &state_, &seconds_shared_) {
+      shared_(DataTermsOf(energy), &state_, &seconds_shared_) {
   ceres::Problem::Options problem_options;
   problem_options.evaluation_callback = &shared_;
   problem_options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   // Ceres' checks as the problem is built stay on: disable_all_safety_checks saved ~0.1 of the
   // ~11 ms that building and destroying a synth_skirt problem takes.
   problem_ = std::make_unique<ceres::Problem>(problem_options);
-  cost_functions_.AddResidualBlocks(*energy, secant, layout, &state_, problem_.get());
+  cost_functions_.AddResidualBlocks(energy, secant, layout, &state_, problem_.get());
   shared_.PrepareRowsToo(cost_functions_.model_rows());
 }
 
 bool CeresFrameProblem::Rebind(FrameEnergy* energy, bool secant) {
-  if (secant != secant_ || !cost_functions_.Rebind(*energy)) return false;
-  shared_.Rebind(&energy->similarity());
+  if (secant != secant_ || !cost_functions_.Rebind(energy)) return false;
+  shared_.Rebind(DataTermsOf(energy));
   return true;
 }
 

@@ -13,9 +13,11 @@ namespace finecap {
 
 double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
   std::vector<double> block_costs;
-  energy->similarity().BlockCosts(k, &block_costs);
   double sum_of_squares = 0.0;
-  for (double cost : block_costs) sum_of_squares += cost;
+  for (int t = 0; t < energy->num_data_terms(); ++t) {
+    energy->data_term(t).BlockCosts(k, &block_costs);
+    for (double cost : block_costs) sum_of_squares += cost;
+  }
   // The differences' residuals root (k_a - k_b) and the pulls', sqrt(p_s) (k_s - t_s): their
   // half sums of squares are the parts of E_quad.
   return 0.5 * sum_of_squares + energy->DifferenceEnergy(k, nullptr) + energy->PullEnergy(k);
@@ -24,7 +26,7 @@ double LeastSquaresCost(FrameEnergy* energy, const Eigen::VectorXd& k) {
 void EvaluateEnergyAndCost(FrameEnergy* energy, const Eigen::VectorXd& k, double* energy_value,
                            double* cost) {
   *cost = LeastSquaresCost(energy, k);
-  *energy_value = energy->similarity().IsLeastSquares() ? -*cost : energy->Evaluate(k, nullptr);
+  *energy_value = energy->IsLeastSquares() ? -*cost : energy->Evaluate(k, nullptr);
 }
 
 void SolverSummary::AddWork(const SolverSummary& more) {
@@ -77,8 +79,7 @@ SolverSummary FrameSolver::Solve(Eigen::VectorXd* k) {
   *k = k->cwiseMax(-k_max).cwiseMin(k_max);
   SolverSummary summary;
   summary.solver = EnumToString(options_.type);
-  if (options_.type == SolverType::kCeres && energy_->similarity().IsLeastSquares() &&
-      k->size() > 0) {
+  if (options_.type == SolverType::kCeres && energy_->IsLeastSquares() && k->size() > 0) {
     // Ceres' own start and final costs are the least-squares cost, and so give E.
     const Eigen::VectorXd start = *k;
     summary.ls_cost_start = summary.ls_cost_end = std::nan("");

@@ -8,19 +8,24 @@ namespace finecap {
 
 namespace {
 
-// costs(s, j): the data cost of Gaussian s at displacement j.
-Eigen::MatrixXd SweepCosts(FrameEnergy* energy, const Eigen::VectorXd& displacements) {
-  SimilarityTerm& term = energy->similarity();
+// costs(s, j): the data cost of Gaussian s at displacement j, summed over the data terms that
+// offer sweep costs (SweepCosts).
+Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& displacements) {
   const int n = energy->num_parameters();
-  Eigen::MatrixXd block_costs;
-  term.UniformBlockCosts(n, displacements, &block_costs);
   Eigen::MatrixXd costs = Eigen::MatrixXd::Zero(n, displacements.size());
-  const auto& blocks = term.residual_blocks();
-  // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
-  for (int j = 0; j < displacements.size(); ++j) {
-    for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
-      for (int s : blocks[b].parameters)
-        costs(s, j) += block_costs(b, j) / blocks[b].parameters.size();
+  Eigen::MatrixXd block_costs;
+  for (int t = 0; t < energy->num_data_terms(); ++t) {
+    DataTerm& term = energy->data_term(t);
+    SweepCosts* sweep = term.sweep_costs();
+    if (sweep == nullptr) continue;
+    sweep->UniformBlockCosts(n, displacements, &block_costs);
+    const auto& blocks = term.residual_blocks();
+    // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
+    for (int j = 0; j < displacements.size(); ++j) {
+      for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+        for (int s : blocks[b].parameters)
+          costs(s, j) += block_costs(b, j) / blocks[b].parameters.size();
+      }
     }
   }
   return costs;
@@ -34,7 +39,7 @@ Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& opt
   if (options.samples == 0) return Eigen::VectorXd::Zero(n);
   const double k_max = energy->layout().bound;
   const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
-  Eigen::MatrixXd costs = SweepCosts(energy, displacements);
+  Eigen::MatrixXd costs = CostsPerGaussian(energy, displacements);
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];
   Eigen::VectorXd k(n);

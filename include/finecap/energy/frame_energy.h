@@ -1,10 +1,16 @@
-// The energy of one frame, E(k) = E_sim(k) - E_quad(k): the similarity and the terms quadratic in
-// k (quadratic_term.h: the paper's w_reg * E_reg, eq. 3, and the pulls that are not in the paper,
+// The energy of one frame, E(k) = E_data(k) - E_quad(k): the data terms (data_term.h; today one,
+// the similarity: the paper's E_sim or a variant) summed, less the terms quadratic in k
+// (quadratic_term.h: the paper's w_reg * E_reg, eq. 3, and the pulls that are not in the paper,
 // towards the input and towards the frame before), built from the surface Gaussians, the cameras
 // with their image Gaussians and visibility, and the mesh's neighbourhoods. Which terms it holds
 // follows from the options alone (src/energy/term_registry.cc). It owns the pair lists, so it is
 // built once per frame and then evaluated many times by a solver; it is neither copied nor moved
 // (the terms refer to its members).
+//
+// It is the frame's problem as the solvers see it: the unknowns (layout), the summed value and
+// gradient (Evaluate), the data terms with their residual blocks and the capabilities each
+// offers, and the quadratic part as pulls and differences. The solvers do not know which terms
+// made it.
 #ifndef FINECAP_FRAME_ENERGY_H_
 #define FINECAP_FRAME_ENERGY_H_
 
@@ -15,11 +21,11 @@
 #include <Eigen/SparseCore>
 #include <opencv2/core.hpp>
 
+#include "finecap/energy/data_term.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/parameter_layout.h"
 #include "finecap/energy/quadratic_term.h"
 #include "finecap/energy/regularizer.h"
-#include "finecap/energy/similarity.h"
 #include "finecap/geometry/neighbourhood.h"
 #include "finecap/model/gaussian_pairs.h"
 #include "finecap/model/surface_gaussians.h"
@@ -82,12 +88,32 @@ class FrameEnergy {
   ParameterLayout layout() const { return {num_parameters(), options_.k_max}; }
   const SurfaceGaussians& surface() const { return surface_; }
   const EnergyOptions& options() const { return options_; }
+  // The unknowns' values taken from one value per mesh vertex: entry s is the value at surface
+  // Gaussian s's vertex (SurfaceGaussians::vertex_ids).
+  Eigen::VectorXd UnknownsAtVertices(const Eigen::VectorXd& per_vertex) const;
   // The cameras' pair lists, without their image Gaussian ids, and without the image Gaussians
-  // themselves (EnergyView::image null), when the similarity does not read them after it is built
-  // (SimilarityTerm::ReadsPairLists): the image models may then go.
+  // themselves (EnergyView::image null), when no data term reads them after it is built
+  // (ReadsPairLists): the image models may then go.
   const std::vector<EnergyView>& views() const { return views_; }
-  SimilarityTerm& similarity() { return *similarity_; }
-  const SimilarityTerm& similarity() const { return *similarity_; }
+
+  // The data terms, summed in this order.
+  int num_data_terms() const { return static_cast<int>(data_terms_.size()); }
+  DataTerm& data_term(int i) { return *data_terms_[i]; }
+  const DataTerm& data_term(int i) const { return *data_terms_[i]; }
+  // Adds `term` to the sum. The pulls stated in the data's units (TermContext::
+  // typical_data_curvature) keep the measure taken of the terms the energy was built with, and
+  // the pair lists stay as they are.
+  void AddDataTerm(std::unique_ptr<DataTerm> term);
+  // Whether every data term is least-squares (DataTerm::IsLeastSquares): then E is minus the
+  // least-squares cost, E_data's half sum of squares plus E_quad.
+  bool IsLeastSquares() const;
+  // Whether some data term reads the pair lists after it is built (DataTerm::ReadsPairLists).
+  bool ReadsPairLists() const;
+  // Whether some data term changes between passes of the solver (PassHook), and, handing it the
+  // surface `k` a pass ended at, changes it.
+  bool HasPassHooks() const;
+  void EndOfPass(const Eigen::VectorXd& k);
+
   const Regularizer& regularizer() const { return regularizer_; }
   // The quadratic part, as its terms made it: the pulls on each k_s, gathered into one p_s and
   // t_s per surface Gaussian, and the differences of neighbours.
@@ -111,8 +137,8 @@ class FrameEnergy {
   // Evaluated pairs of Gaussians, summed over cameras.
   long num_pairs() const;
 
-  // E at k and, when `gradient` is not null, dE/dk. E_sim and E_quad go to the optional outputs.
-  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient, double* similarity = nullptr,
+  // E at k and, when `gradient` is not null, dE/dk. E_data and E_quad go to the optional outputs.
+  double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient, double* data = nullptr,
                   double* quadratic = nullptr) const;
 
  private:
@@ -127,8 +153,8 @@ class FrameEnergy {
   SurfaceSamples samples_;
   std::vector<CameraInput> sample_cameras_;
   std::vector<EnergyView> views_;
-  std::unique_ptr<SimilarityTerm> similarity_;
-  Regularizer regularizer_;
+  Regularizer regularizer_;  // Before the data terms: a term may read it.
+  std::vector<std::unique_ptr<DataTerm>> data_terms_;
   Eigen::VectorXd confidence_;
   std::vector<std::unique_ptr<QuadraticTerm>> quadratic_terms_;
   Pulls pulls_;

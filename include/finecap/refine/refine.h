@@ -246,8 +246,8 @@ struct PreparedFrame {
   // Per camera, which vertices of `fine` it sees by the geometry alone, whatever the masks say
   // (ComputeFrameVisibility).
   std::vector<std::vector<unsigned char>> visible;
-  // One per camera, while the energy refers to them: none once it is built when its similarity
-  // reads no pair list after (SimilarityTerm::ReadsPairLists; the consensus similarity's tables
+  // One per camera, while the energy refers to them: none once it is built when no data term
+  // reads a pair list after (FrameEnergy::ReadsPairLists; the consensus similarity's tables
   // hold what it needs), which spares a frame's image models (~7 MB on synth_skirt) while it is
   // solved and while the next one waits.
   std::vector<ImageGaussians> images;
@@ -266,8 +266,8 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 // Replaces the energy of a prepared (and usually solved) frame by the one that reads the input's
 // images at their own resolution over the same surface Gaussians (ConsensusOptions::
 // sample_spacing), with the visibility the frame was prepared with: the
-// detail stage RefineFrame solves last. Its patches start unshaped (SimilarityTerm::
-// SetPatchShape).
+// detail stage RefineFrame solves last. Its patches start unshaped, until it is handed the
+// surface solved before (FrameEnergy::EndOfPass).
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
                          const RefineOptions& options, PreparedFrame* frame);
 

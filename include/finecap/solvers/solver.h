@@ -1,9 +1,10 @@
 // The solvers of one frame's energy (frame_energy.h). All take the same problem and report the
 // same statistics, so that experiments can set them side by side:
 //
-//  * "ceres" (default): the least-squares form, the similarity's residual blocks plus one linear
-//    residual per pair of neighbours (one residual block per surface Gaussian holding both where
-//    its similarity block has one parameter), with hand-written Jacobians; Levenberg-Marquardt with
+//  * "ceres" (default): the least-squares form, the data terms' residual blocks plus one linear
+//    residual per pair of neighbours (one residual block per surface Gaussian holding both, with
+//    the data blocks of its k_s alone reduced to one row summed over the terms), with
+//    hand-written Jacobians; Levenberg-Marquardt with
 //    conjugate gradients on the normal equations (or a sparse Cholesky factorisation); each k_s a
 //    bounded 1-D parameter block; the shared work of an evaluation done once in a
 //    ceres::EvaluationCallback; a block of one parameter modelled with the secant curvature of
@@ -43,7 +44,7 @@ const std::vector<EnumName<LinearSolverType>>& EnumNames(LinearSolverType);
 
 // Ceres only: the curvature of the model of a similarity block of one parameter. Gauss-Newton's
 // J^T J, or the secant of the block's gradient between its last two evaluations, held within a
-// factor of J^T J (ceres_cost_functions.h, ReducedSimilarityBlockCost).
+// factor of J^T J (ceres_cost_functions.h, ReducedDataBlockCost).
 enum class CurvatureModel { kGaussNewton, kSecant };
 const std::vector<EnumName<CurvatureModel>>& EnumNames(CurvatureModel);
 
@@ -101,8 +102,8 @@ struct SolverSummary {
   double seconds = 0.0;
   double seconds_evaluation = 0.0;     // Residuals, Jacobians, energies and gradients.
   double seconds_linear_solver = 0.0;  // Ceres only.
-  // Ceres only: of seconds_evaluation, the similarity's work shared by its residual blocks at
-  // each new point (SimilarityTerm::PrepareBlockSummaries, all threads); the rest is Ceres' own
+  // Ceres only: of seconds_evaluation, the data terms' work shared by their residual blocks at
+  // each new point (BlockSummaries::PrepareBlockSummaries, all threads); the rest is Ceres' own
   // pass over the residual blocks.
   double seconds_similarity = 0.0;
   std::string termination;  // Why the solver stopped.

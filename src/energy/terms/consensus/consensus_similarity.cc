@@ -339,7 +339,7 @@ void ConsensusSimilarity::UniformBlockCosts(int num_parameters,
                                             const Eigen::VectorXd& displacements,
                                             Eigen::MatrixXd* costs) {
   if (!shape_.isZero(0.0)) {
-    SimilarityTerm::UniformBlockCosts(num_parameters, displacements, costs);
+    SummarisedDataTerm::UniformBlockCosts(num_parameters, displacements, costs);
     return;
   }
   const long num_blocks = static_cast<long>(blocks_.size());

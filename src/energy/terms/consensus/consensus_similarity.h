@@ -49,8 +49,8 @@
 #include <vector>
 
 #include "energy/terms/consensus/patch_agreement.h"
+#include "finecap/energy/data_term.h"
 #include "finecap/energy/energy_options.h"
-#include "finecap/energy/similarity.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/model/surface_gaussians.h"
 

@@ -140,17 +140,16 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
 // |r'|^2 = alpha^2 s, <r', dr'/dk> = alpha^2 g + alpha a' s and
 // |dr'/dk|^2 = alpha^2 h + 2 alpha a' g + a'^2 s.
 // Without derivatives |r'|^2 = rho(s) alone, without alpha's square root and divisions.
-SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSummary& plain,
-                                       bool with_derivatives) {
+BlockSummary Robustify(double c2, const BlockSummary& plain, bool with_derivatives) {
   if (c2 <= 0.0) return plain;
   if (!with_derivatives && plain.squared_norm >= 1e-6 * c2) {
-    SimilarityTerm::BlockSummary robust;
+    BlockSummary robust;
     robust.squared_norm = c2 * std::log1p(plain.squared_norm / c2);
     return robust;
   }
   const CauchyScaling scaling(c2, plain.squared_norm);
   const double alpha = scaling.alpha, dalpha_dk = scaling.dalpha_ds * 2.0 * plain.gradient;
-  SimilarityTerm::BlockSummary robust;
+  BlockSummary robust;
   robust.squared_norm = alpha * alpha * plain.squared_norm;
   robust.gradient = alpha * alpha * plain.gradient + alpha * dalpha_dk * plain.squared_norm;
   robust.curvature = alpha * alpha * plain.curvature + 2.0 * alpha * dalpha_dk * plain.gradient +
@@ -163,6 +162,16 @@ SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSum
 PatchAgreementTerm::PatchAgreementTerm(const ConsensusOptions& options, int num_cameras)
     : options_(options), scale_(1.0 / std::sqrt(static_cast<double>(std::max(num_cameras, 1)))) {
   options_.Check();
+}
+
+void PatchAgreementTerm::EndOfPass(const Eigen::VectorXd& k) {
+  if (neighbours_ == nullptr) {
+    SetPatchShape(k);
+    return;
+  }
+  Eigen::MatrixXd shape = k;
+  neighbours_->AverageOverNeighbours(options_.shape_smoothing_rounds, &shape);
+  SetPatchShape(shape.col(0));
 }
 
 void PatchAgreementTerm::AddPatch(int parameter, const std::vector<int>& members,
@@ -199,8 +208,7 @@ double PatchAgreementTerm::LossScale(int b) const {
                                       options_.robust_fraction);
 }
 
-SimilarityTerm::BlockSummary PatchAgreementTerm::SummaryAt(int b, double k,
-                                                           bool with_derivatives) const {
+BlockSummary PatchAgreementTerm::SummaryAt(int b, double k, bool with_derivatives) const {
   thread_local std::vector<double> residuals, jacobian;
   const int num_residuals = blocks_[b].num_residuals;
   residuals.resize(num_residuals);

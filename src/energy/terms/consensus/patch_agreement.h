@@ -8,8 +8,9 @@
 
 #include <Eigen/Core>
 
+#include "finecap/energy/data_term.h"
 #include "finecap/energy/energy_options.h"
-#include "finecap/energy/similarity.h"
+#include "finecap/energy/regularizer.h"
 
 namespace finecap {
 namespace internal {
@@ -44,8 +45,7 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
 
 // The summary of a block's residuals after Robustify from that of its residuals before it,
 // without either.
-SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSummary& plain,
-                                       bool with_derivatives);
+BlockSummary Robustify(double c2, const BlockSummary& plain, bool with_derivatives);
 
 }  // namespace internal
 
@@ -54,7 +54,11 @@ SimilarityTerm::BlockSummary Robustify(double c2, const SimilarityTerm::BlockSum
 // residuals, robust loss, block summaries and costs of both consensus similarities. A derived
 // term says where a patch's colours come from (PatchColors), adds its patches (AddPatch) and then
 // weighs them (WeighPatches).
-class PatchAgreementTerm : public SimilarityTerm {
+//
+// Between two passes of the solver (PassHook) its patches take the shape of the surface the pass
+// found, smoothed over the mesh neighbours: the window's displacement, not each member's noise
+// about it (ConsensusOptions::shape_smoothing_rounds).
+class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
  public:
   double Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient) const override;
   const std::vector<ResidualBlock>& residual_blocks() const override { return blocks_; }
@@ -67,7 +71,15 @@ class PatchAgreementTerm : public SimilarityTerm {
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
   bool IsLeastSquares() const override { return true; }
   bool ReadsPairLists() const override { return false; }
-  bool ShapesPatches() const override { return true; }
+  PassHook* pass_hook() override { return this; }
+  // Shapes the patches like `k`, smoothed over the neighbours given with SmoothShapesOver.
+  void EndOfPass(const Eigen::VectorXd& k) override;
+
+  // The neighbours over which EndOfPass smooths the surface it is given; not owned, and must
+  // outlive the term. Without them the shape is the surface as it is.
+  void SmoothShapesOver(const Regularizer* neighbours) { neighbours_ = neighbours; }
+  // The shape of the patches, one displacement per surface Gaussian (zero: the input surface).
+  virtual void SetPatchShape(const Eigen::VectorXd& shape) = 0;
 
   // The weight w_s of each block, per channel (the patch's contrast at the input surface).
   const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
@@ -98,6 +110,7 @@ class PatchAgreementTerm : public SimilarityTerm {
   BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
 
   ConsensusOptions options_;
+  const Regularizer* neighbours_ = nullptr;
   double scale_;  // 1 / sqrt(n_c).
   std::vector<ResidualBlock> blocks_;
   std::vector<Eigen::Vector3d> weights_;

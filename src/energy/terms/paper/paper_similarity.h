@@ -14,13 +14,13 @@
 
 #include <vector>
 
-#include "finecap/energy/similarity.h"
+#include "finecap/energy/data_term.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/model/surface_gaussians.h"
 
 namespace finecap {
 
-class PaperSimilarity : public SimilarityTerm {
+class PaperSimilarity : public SummarisedDataTerm {
  public:
   // `views` must have been built with colour weights (PairOptions::color_cutoff > 0); both
   // arguments must outlive this object.

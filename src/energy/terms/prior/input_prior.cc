@@ -6,16 +6,16 @@
 
 namespace finecap {
 
-Eigen::VectorXd DataCurvature(SimilarityTerm* similarity, const Eigen::VectorXd& k) {
-  similarity->PrepareResiduals(k, true);
+Eigen::VectorXd DataCurvature(DataTerm* term, const Eigen::VectorXd& k) {
+  term->PrepareResiduals(k, true);
   Eigen::VectorXd curvature = Eigen::VectorXd::Zero(k.size());
   std::vector<double> residuals, jacobian;
-  const auto& blocks = similarity->residual_blocks();
+  const auto& blocks = term->residual_blocks();
   for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
     const int num_parameters = static_cast<int>(blocks[b].parameters.size());
     residuals.resize(blocks[b].num_residuals);
     jacobian.resize(blocks[b].num_residuals * num_parameters);
-    similarity->BlockResiduals(b, residuals.data(), jacobian.data());
+    term->BlockResiduals(b, residuals.data(), jacobian.data());
     for (int r = 0; r < blocks[b].num_residuals; ++r) {
       for (int p = 0; p < num_parameters; ++p) {
         const double derivative = jacobian[r * num_parameters + p];

@@ -19,10 +19,10 @@
 
 #include <Eigen/Core>
 
+#include "finecap/energy/data_term.h"
 #include "finecap/energy/energy_options.h"
 #include "finecap/energy/quadratic_term.h"
 #include "finecap/energy/regularizer.h"
-#include "finecap/energy/similarity.h"
 #include "finecap/model/surface_gaussians.h"
 
 namespace finecap {
@@ -31,9 +31,9 @@ namespace finecap {
 // information about what a typical one is held by.
 double MedianOfPositive(const Eigen::VectorXd& values);
 
-// H_s = sum over the similarity's residuals r of (dr/dk_s)^2 at `k`: the diagonal of the
+// H_s = sum over the data term's residuals r of (dr/dk_s)^2 at `k`: the diagonal of the
 // Gauss-Newton approximation of the least-squares cost's Hessian, one entry per parameter.
-Eigen::VectorXd DataCurvature(SimilarityTerm* similarity, const Eigen::VectorXd& k);
+Eigen::VectorXd DataCurvature(DataTerm* term, const Eigen::VectorXd& k);
 
 // How much the reference colours vary around each surface Gaussian: over the Gaussian and its
 // regulariser neighbours, the median squared distance of their colours from their per-channel

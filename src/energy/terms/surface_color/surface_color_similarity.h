@@ -24,7 +24,7 @@
 
 #include <vector>
 
-#include "finecap/energy/similarity.h"
+#include "finecap/energy/data_term.h"
 #include "finecap/model/gaussian_overlap.h"
 #include "finecap/model/surface_gaussians.h"
 
@@ -38,7 +38,7 @@ Eigen::Vector3d ImageColorOfPairs(const EnergyView& view, const SurfaceGaussians
                                   double k, OverlapForm form, const Eigen::Vector3d& fallback,
                                   Eigen::Vector3d* derivative, double reach_sigmas = 0.0);
 
-class SurfaceColorSimilarity : public SimilarityTerm {
+class SurfaceColorSimilarity : public SummarisedDataTerm {
  public:
   // `views` must have been built without colour weights (PairOptions::color_cutoff <= 0); both
   // arguments must outlive this object.

@@ -64,7 +64,7 @@ TEST(TemporalTermTest, TheFrameBeforeJoinsThePriorAsOneQuadratic) {
   Eigen::VectorXd before = RandomK(n, 0.003, 12);
   before[1] = std::nan("");  // A vertex the frame before did not refine: not pulled.
   pulled.TakeFrameBefore(before);
-  const double h = MedianOfPositive(DataCurvature(&pulled.similarity(), Eigen::VectorXd::Zero(n)));
+  const double h = MedianOfPositive(DataCurvature(&pulled.data_term(0), Eigen::VectorXd::Zero(n)));
   ASSERT_GT(h, 0.0);
   EXPECT_EQ(pulled.pull_curvature()[1], plain.pull_curvature()[1]);
   EXPECT_EQ(pulled.pull_target()[1], plain.pull_target()[1]);

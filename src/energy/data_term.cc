@@ -1,8 +1,8 @@
-#include "finecap/energy/similarity.h"
+#include "finecap/energy/data_term.h"
 
 namespace finecap {
 
-void SimilarityTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
+void DataTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) {
   PrepareResiduals(k, false);
   const int num_blocks = static_cast<int>(residual_blocks().size());
   costs->resize(num_blocks);
@@ -20,18 +20,17 @@ void SimilarityTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* c
   }
 }
 
-void SimilarityTerm::UniformBlockCosts(int num_parameters, const Eigen::VectorXd& displacements,
-                                       Eigen::MatrixXd* costs) {
+void SummarisedDataTerm::UniformBlockCosts(int num_unknowns, const Eigen::VectorXd& displacements,
+                                           Eigen::MatrixXd* costs) {
   costs->resize(static_cast<Eigen::Index>(residual_blocks().size()), displacements.size());
   std::vector<double> block_costs;
   for (int j = 0; j < displacements.size(); ++j) {
-    BlockCosts(Eigen::VectorXd::Constant(num_parameters, displacements[j]), &block_costs);
+    BlockCosts(Eigen::VectorXd::Constant(num_unknowns, displacements[j]), &block_costs);
     costs->col(j) = Eigen::Map<const Eigen::VectorXd>(block_costs.data(), costs->rows());
   }
 }
 
-SimilarityTerm::BlockSummary SimilarityTerm::Summarise(const double* residuals,
-                                                       const double* jacobian, int m) {
+BlockSummary SummarisedDataTerm::Summarise(const double* residuals, const double* jacobian, int m) {
   BlockSummary summary;
   for (int r = 0; r < m; ++r) {
     summary.squared_norm += residuals[r] * residuals[r];
@@ -41,7 +40,7 @@ SimilarityTerm::BlockSummary SimilarityTerm::Summarise(const double* residuals,
   return summary;
 }
 
-void SimilarityTerm::PrepareBlockSummaries(const Eigen::VectorXd& k) {
+void SummarisedDataTerm::PrepareBlockSummaries(const Eigen::VectorXd& k) {
   PrepareResiduals(k, true);
   const int num_blocks = static_cast<int>(residual_blocks().size());
   summaries_.resize(num_blocks);
