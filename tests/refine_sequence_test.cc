@@ -210,9 +210,9 @@ TEST(RefineSequenceTest, TheSharedAppearanceComesFromTheFrameBeforesFile) {
   const OneWorkerThread one_thread;
   const std::string root = MakeTempDir("sequence_appearance");
   Capture capture = testing_util::OpenTinyCapture(root, 3);
-  const int num_vertices =
-      SequenceModel(capture.ReadCoarseMesh(0), {}, testing_util::QuickSequenceOptions().refine, "test")
-          .num_fine_vertices();
+  const int num_vertices = SequenceModel(capture.ReadCoarseMesh(0), {},
+                                         testing_util::QuickSequenceOptions().refine, "test")
+                               .num_fine_vertices();
   SequenceOptions shared_options = testing_util::QuickSequenceOptions();
   shared_options.refine.energy.consensus.shared_appearance = true;
   const std::string plain = root + "/plain", shared = root + "/shared", parts = root + "/parts";
