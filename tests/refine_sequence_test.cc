@@ -229,19 +229,11 @@ TEST(RefineSequenceTest, TheSharedAppearanceComesFromTheFrameBeforesFile) {
   EXPECT_NE(FileBytes(FrameFilesIn(shared, "000001", MeshFormat::kPly).displacement),
             FileBytes(FrameFilesIn(plain, "000001", MeshFormat::kPly).displacement));
 
-  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
-    RefineSequence(&capture, part, shared_options, parts);
-  }
+  testing_util::RefineInParts(&capture, shared_options, parts);
   for (const std::string frame : {"000001", "000002"}) {
     EXPECT_EQ(FileBytes(AppearancePath(parts, frame)), FileBytes(AppearancePath(shared, frame)))
         << frame;
-    const Eigen::VectorXd whole_k =
-        ReadDisplacement(FrameFilesIn(shared, frame, MeshFormat::kPly).displacement, num_vertices);
-    const Eigen::VectorXd parts_k =
-        ReadDisplacement(FrameFilesIn(parts, frame, MeshFormat::kPly).displacement, num_vertices);
-    EXPECT_LT(
-        (whole_k - parts_k).array().isFinite().select(whole_k - parts_k, 0.0).cwiseAbs().maxCoeff(),
-        1e-9)
+    EXPECT_LT(testing_util::LargestDisplacementDifference(shared, parts, frame, num_vertices), 1e-9)
         << frame;
   }
 }

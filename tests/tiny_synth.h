@@ -6,6 +6,7 @@
 
 #include "finecap/config/config.h"
 #include "finecap/io/capture.h"
+#include "finecap/refine/run_folder.h"
 #include "finecap/refine/sequence.h"
 #include "finecap/synth/synth.h"
 
@@ -71,6 +72,26 @@ inline SequenceOptions QuickSequenceOptions() {
   options.refine.solver.num_threads = 1;
   options.refine.sweep.samples = 0;
   return options;
+}
+
+// Frames 0-2 of `capture` refined into `out` as a run stopped after frame 0 and resumed to frame 1,
+// then frame 2 as a shard of its own.
+inline void RefineInParts(Capture* capture, const SequenceOptions& options,
+                          const std::string& out) {
+  for (const FrameRange part : {FrameRange{0, 1}, FrameRange{0, 2}, FrameRange{2, 3}}) {
+    RefineSequence(capture, part, options, out);
+  }
+}
+
+// The largest difference of the displacements that the run folders `a` and `b` saved for
+// `frame`, over the vertices refined in both, metres.
+inline double LargestDisplacementDifference(const std::string& a, const std::string& b,
+                                            const std::string& frame, int num_vertices) {
+  const Eigen::VectorXd k_a =
+      ReadDisplacement(FrameFilesIn(a, frame, MeshFormat::kPly).displacement, num_vertices);
+  const Eigen::VectorXd k_b =
+      ReadDisplacement(FrameFilesIn(b, frame, MeshFormat::kPly).displacement, num_vertices);
+  return (k_a - k_b).array().isFinite().select(k_a - k_b, 0.0).cwiseAbs().maxCoeff();
 }
 
 }  // namespace testing_util

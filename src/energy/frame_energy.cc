@@ -77,14 +77,8 @@ double FrameEnergy::TypicalDataCurvature() {
   // the solvers see one energy throughout.
   if (typical_data_curvature_ < 0.0) {
     const Eigen::VectorXd input = Eigen::VectorXd::Zero(surface_.size());
-    Eigen::VectorXd curvature = input;
-    for (size_t i = 0; i < data_terms_.size(); ++i) {
-      if (i == 0) {
-        curvature = DataCurvature(data_terms_[i].get(), input);
-      } else {
-        curvature += DataCurvature(data_terms_[i].get(), input);
-      }
-    }
+    Eigen::VectorXd curvature = Eigen::VectorXd::Zero(surface_.size());
+    for (const auto& term : data_terms_) curvature += DataCurvature(term.get(), input);
     typical_data_curvature_ = MedianOfPositive(curvature);
   }
   return typical_data_curvature_;
@@ -162,18 +156,13 @@ long FrameEnergy::num_pairs() const { return num_pairs_; }
 
 double FrameEnergy::Evaluate(const Eigen::VectorXd& k, Eigen::VectorXd* gradient, double* data,
                              double* quadratic) const {
-  // The terms' sum starts from the first term's value and gradient themselves, not from zero.
-  Eigen::VectorXd data_gradient, term_gradient, difference_gradient;
+  Eigen::VectorXd data_gradient = Eigen::VectorXd::Zero(k.size()), term_gradient,
+                  difference_gradient;
   double e_data = 0.0;
-  for (size_t i = 0; i < data_terms_.size(); ++i) {
-    Eigen::VectorXd* into = gradient == nullptr ? nullptr
-                            : i == 0            ? &data_gradient
-                                                : &term_gradient;
-    const double value = data_terms_[i]->Evaluate(k, into);
-    e_data = i == 0 ? value : e_data + value;
-    if (i > 0 && gradient != nullptr) data_gradient += term_gradient;
+  for (const auto& term : data_terms_) {
+    e_data += term->Evaluate(k, gradient != nullptr ? &term_gradient : nullptr);
+    if (gradient != nullptr) data_gradient += term_gradient;
   }
-  if (data_terms_.empty()) data_gradient = Eigen::VectorXd::Zero(k.size());
   const double e_differences = DifferenceEnergy(k, gradient ? &difference_gradient : nullptr);
   const double e_pulls = PullEnergy(k);
   if (gradient != nullptr) {

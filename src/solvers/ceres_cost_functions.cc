@@ -420,10 +420,7 @@ void FrameCostFunctions::AddResidualBlocks(FrameEnergy* energy, bool secant, Lay
     const SmoothnessBlockCost::Neighbour* neighbours = neighbours_.data() + rows.begin[s];
     if (per_gaussian) {
       const int row = model_rows_->Add(s, std::max(0.0, prior[s]), target[s]);
-      for (int t = 0; t < num_terms; ++t) {
-        if (merged[t][s] < 0) continue;
-        model_rows_->AddBlock(row, energy->data_term(t).block_summaries(), merged[t][s]);
-      }
+      AddSummaryBlocks(row, s, merged, energy);
       surface_gaussians_.emplace_back(*model_rows_, row, neighbours, rows.num_neighbours(s),
                                       num_free);
       problem->AddResidualBlock(&surface_gaussians_.back(), nullptr, parameter_blocks);
@@ -454,6 +451,15 @@ std::vector<int> FrameCostFunctions::OneBlockPerGaussian(DataTerm* term, int num
   return block_of;
 }
 
+void FrameCostFunctions::AddSummaryBlocks(int row, int s,
+                                          const std::vector<std::vector<int>>& block_of,
+                                          FrameEnergy* energy) {
+  for (int t = 0; t < static_cast<int>(block_of.size()); ++t) {
+    if (block_of[t].empty() || block_of[t][s] < 0) continue;
+    model_rows_->AddBlock(row, energy->data_term(t).block_summaries(), block_of[t][s]);
+  }
+}
+
 bool FrameCostFunctions::Rebind(FrameEnergy* energy) {
   const int num_gaussians = model_rows_ != nullptr ? model_rows_->size() : 0;
   if (!rebindable_ || energy->num_parameters() != num_gaussians ||
@@ -475,10 +481,7 @@ bool FrameCostFunctions::Rebind(FrameEnergy* energy) {
   const Eigen::VectorXd& target = energy->pull_target();
   for (int s = 0; s < num_gaussians; ++s) {
     model_rows_->Set(s, std::max(0.0, prior[s]), target[s]);
-    for (int t = 0; t < num_terms; ++t) {
-      if (block_of[t].empty() || block_of[t][s] < 0) continue;
-      model_rows_->AddBlock(s, energy->data_term(t).block_summaries(), block_of[t][s]);
-    }
+    AddSummaryBlocks(s, s, block_of, energy);
   }
   return true;
 }

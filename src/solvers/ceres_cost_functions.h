@@ -351,6 +351,10 @@ class FrameCostFunctions {
   // For each surface Gaussian, the block of `term` of its k_s alone when every block of the term
   // is one, of one parameter, and the term offers summaries; empty otherwise.
   static std::vector<int> OneBlockPerGaussian(DataTerm* term, int num_gaussians);
+  // Hands model row `row`, of surface Gaussian s, the block block_of[t][s] of each term t that
+  // has one (an empty list or -1: none).
+  void AddSummaryBlocks(int row, int s, const std::vector<std::vector<int>>& block_of,
+                        FrameEnergy* energy);
 
   // Whether Rebind can take an energy: the layout and what its residual blocks were made of.
   bool rebindable_ = false;
