@@ -138,7 +138,7 @@ void BM_DetailBlockSummaries(benchmark::State& state) {
   const RefineOptions options;
   PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
-  PrepareDetailEnergy(*skirt.model, skirt.input, options, &frame);
+  PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
   omp_set_num_threads(threads);
   for (auto _ : state) frame.energy->data_term(0).block_summaries()->PrepareBlockSummaries(k);
   omp_set_num_threads(omp_get_num_procs());

@@ -87,6 +87,34 @@ TEST_F(RefineFrameTest, AFrameHandsOnTheAppearanceOfTheSurfaceItWrites) {
   EXPECT_EQ(result.appearance.cols(), 0);
 }
 
+// The detail stage reads each patch in the cameras that see the surface the first stage found
+// within VisibilityOptions::sample_view_angle_deg: a wider angle than the first stage's gives it
+// more comparisons. A found surface of the wrong size is refused.
+TEST_F(RefineFrameTest, TheDetailStageReadsTheCamerasWithinItsOwnAngle) {
+  Capture capture = Capture::Open(*directory_);
+  const RefineOptions defaults;
+  const FrameInput input = ReadFrameInput(&capture, 0);
+  const SequenceModel model(input.coarse, {}, defaults, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, input, defaults);
+  const auto detail_residuals = [&](double angle) {
+    RefineOptions options = defaults;
+    options.visibility.sample_view_angle_deg = angle;
+    PreparedFrame frame = PrepareFrame(model, colors, input, options);
+    const Eigen::VectorXd found = Eigen::VectorXd::Zero(frame.energy->num_parameters());
+    PrepareDetailEnergy(model, input, options, found, &frame);
+    long residuals = 0;
+    for (const auto& block : frame.energy->data_term(0).residual_blocks()) {
+      residuals += block.num_residuals;
+    }
+    return residuals;
+  };
+  EXPECT_GT(detail_residuals(80.0), detail_residuals(defaults.visibility.max_view_angle_deg));
+
+  PreparedFrame frame = PrepareFrame(model, colors, input, defaults);
+  const Eigen::VectorXd too_short = Eigen::VectorXd::Zero(frame.energy->num_parameters() - 1);
+  EXPECT_THROW(PrepareDetailEnergy(model, input, defaults, too_short, &frame), Error);
+}
+
 // A frame modelled ahead (ModelFrameImages) gives its own models to every stage that asks with the
 // same options, keeps those of the cameras left after the held-out ones are set aside, and is
 // modelled afresh under other options; the frame it solves to is the one it solves to unmodelled.

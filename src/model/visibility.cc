@@ -23,6 +23,11 @@ const OptionFields<VisibilityOptions>& VisibilityOptions::Fields() {
                 "compares takes the most frontal up to this angle, with less confidence; equal to "
                 "max_view_angle_deg: none.",
                 1.0, 90.0);
+    f.AddDouble("sample_view_angle_deg", &VisibilityOptions::sample_view_angle_deg,
+                "Largest angle between a normal of the surface the surface Gaussians found and "
+                "the direction to a camera whose pixels the detail stage reads "
+                "(energy.consensus.sample_spacing above 0).",
+                1.0, 90.0);
     f.AddDouble("border_margin", &VisibilityOptions::border_margin,
                 "Vertices projecting closer than this to the image border are not used, px.", 0.0,
                 1000.0);

@@ -256,10 +256,44 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
   return frame;
 }
 
+namespace {
+
+// Per camera, which vertices of `frame.fine` the detail stage reads it for: the cameras that see
+// the surface the surface Gaussians found (`found`, smoothed as the patches' shape will be,
+// PatchAgreementTerm::EndOfPass) within VisibilityOptions::sample_view_angle_deg of its normals,
+// by the geometry alone.
+std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& frame,
+                                                         const Eigen::VectorXd& found,
+                                                         const FrameInput& input,
+                                                         const RefineOptions& options) {
+  const FrameEnergy& energy = *frame.energy;
+  Eigen::MatrixXd shape = found;
+  energy.regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
+                                             &shape);
+  Mesh surface = frame.fine;
+  const std::vector<int>& ids = energy.surface().vertex_ids;
+  for (size_t s = 0; s < ids.size(); ++s) {
+    surface.vertices.col(ids[s]) += shape(s, 0) * frame.normals.col(ids[s]);
+  }
+  VisibilityOptions visibility = options.visibility;
+  visibility.max_view_angle_deg = visibility.sample_view_angle_deg;
+  visibility.fallback_view_angle_deg =
+      std::max(visibility.fallback_view_angle_deg, visibility.sample_view_angle_deg);
+  return ComputeFrameVisibility(surface, ComputeVertexNormals(surface), input.cameras, visibility,
+                                FallbackCamerasWanted(options));
+}
+
+}  // namespace
+
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
-                         const RefineOptions& options, PreparedFrame* frame) {
+                         const RefineOptions& options, const Eigen::VectorXd& found,
+                         PreparedFrame* frame) {
   const auto start = std::chrono::steady_clock::now();
   const ConsensusOptions& consensus = options.energy.consensus;
+  Require(found.size() == frame->energy->num_parameters(), "PrepareDetailEnergy",
+          "one displacement per surface Gaussian expected");
+  const std::vector<std::vector<unsigned char>> visible =
+      DetailVisibility(*frame, found, input, options);
   SurfaceGaussians surface = frame->energy->surface();
   frame->energy.reset();  // Its pair lists and tables are not needed any more.
   const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
@@ -273,7 +307,7 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
   std::vector<CameraInput> cameras(input.cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     cameras[c].camera = input.cameras[c];
-    for (int v : surface.vertex_ids) cameras[c].visible.push_back(frame->visible[c][v]);
+    for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
     cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
     if (!input.masks.empty()) {
       cameras[c].samples_on_foreground.assign(samples.size(), 1);
@@ -406,7 +440,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   if (UsesSurfaceSamples(options)) {
     // The images at their own resolution, from the surface the surface Gaussians found.
     const double seconds = frame.seconds;
-    PrepareDetailEnergy(model, input, options, &frame);
+    PrepareDetailEnergy(model, input, options, k, &frame);
     result.seconds_preparation += frame.seconds - seconds;
     // The solve of the Gaussians' stage was this energy's first pass.
     frame.energy->EndOfPass(k);

@@ -32,6 +32,16 @@ struct VisibilityOptions {
   // vertices have one camera within 60 degrees). Evidence from steep views is weaker, and the
   // view confidence (ViewConfidence) says how much weaker. At least max_view_angle_deg.
   double fallback_view_angle_deg = 85.0;
+  // The detail stage (ConsensusOptions::sample_spacing above 0) reads a patch's samples at the
+  // images' own resolution, so a steep view is modelled as the camera sees it, foreshortened,
+  // where a surface Gaussian several pixel footprints wide smears it; and it chooses its cameras
+  // at the surface the surface Gaussians found, whose normals follow the folds the input lacks.
+  // More cameras per patch then pay: synth_skirt_exact (each vertex seen by two or three of
+  // eight cameras within 60 degrees) recovers 38.7 % of the detail with the first stage's
+  // cameras, and 34.7, 42.4, 44.3, 43.8, 42.9 and 40.8 % at 60, 65, 70, 75, 80 and 85 degrees of
+  // the surface found; 70-80 hold the other captures' best too (docs/measurements.md,
+  // 2026-12-05 (night)).
+  double sample_view_angle_deg = 75.0;
   double border_margin = 2.0;
 
   static const OptionFields<VisibilityOptions>& Fields();  // option_fields.h

@@ -263,13 +263,16 @@ struct PreparedFrame {
 PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options);
 
-// Replaces the energy of a prepared (and usually solved) frame by the one that reads the input's
-// images at their own resolution over the same surface Gaussians (ConsensusOptions::
-// sample_spacing), with the visibility the frame was prepared with: the
-// detail stage RefineFrame solves last. Its patches start unshaped, until it is handed the
-// surface solved before (FrameEnergy::EndOfPass).
+// Replaces the energy of a prepared frame, solved to `found` (one k per surface Gaussian), by the
+// one that reads the input's images at their own resolution over the same surface Gaussians
+// (ConsensusOptions::sample_spacing): the detail stage RefineFrame solves last. Its cameras are
+// those that see the surface found, smoothed as its patches' shape will be, within
+// VisibilityOptions::sample_view_angle_deg. Its patches start unshaped, until it is handed the
+// surface solved before (FrameEnergy::EndOfPass). Throws Error unless `found` has one entry per
+// surface Gaussian.
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
-                         const RefineOptions& options, PreparedFrame* frame);
+                         const RefineOptions& options, const Eigen::VectorXd& found,
+                         PreparedFrame* frame);
 
 // PrepareFrame at the level RefineFrame solves last, with the plane sweep's start when that level
 // starts from it (no coarse-to-fine schedule): what RefineFrame does to a frame before it solves
