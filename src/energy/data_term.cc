@@ -20,6 +20,26 @@ void DataTerm::BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) 
   }
 }
 
+Eigen::VectorXd DataTerm::GaussNewtonDiagonal(const Eigen::VectorXd& k) {
+  PrepareResiduals(k, true);
+  Eigen::VectorXd curvature = Eigen::VectorXd::Zero(k.size());
+  std::vector<double> residuals, jacobian;
+  const auto& blocks = residual_blocks();
+  for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
+    const int num_parameters = static_cast<int>(blocks[b].parameters.size());
+    residuals.resize(blocks[b].num_residuals);
+    jacobian.resize(blocks[b].num_residuals * num_parameters);
+    BlockResiduals(b, residuals.data(), jacobian.data());
+    for (int r = 0; r < blocks[b].num_residuals; ++r) {
+      for (int p = 0; p < num_parameters; ++p) {
+        const double derivative = jacobian[r * num_parameters + p];
+        curvature[blocks[b].parameters[p]] += derivative * derivative;
+      }
+    }
+  }
+  return curvature;
+}
+
 void SummarisedDataTerm::UniformBlockCosts(int num_unknowns, const Eigen::VectorXd& displacements,
                                            Eigen::MatrixXd* costs) {
   costs->resize(static_cast<Eigen::Index>(residual_blocks().size()), displacements.size());

@@ -328,11 +328,13 @@ bool ReadsImagesAfterPreparation(const RefineOptions& options) {
 namespace {
 
 // Solve, and for an energy whose terms change between passes (PassHook: the consensus' patches
-// shaped like the surface found so far) the further passes. The summary's start values are those
-// of the last pass's energy at `*k`'s start, so that `worse` compares the frame by the energy it
-// ended with.
+// shaped like the surface found so far) the further passes. With `measure_ends`, the summary's
+// start values are those of the last pass's energy at `*k`'s start, so that `worse` compares the
+// frame by the energy it ended with; without, a caller that only adds up the work or measures
+// the ends itself saves the two evaluations (a detail stage's cost as much as a solver's step).
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
-                               Eigen::VectorXd* k, SolverWorkspace* workspace = nullptr) {
+                               Eigen::VectorXd* k, bool measure_ends,
+                               SolverWorkspace* workspace = nullptr) {
   const int passes = options.energy.consensus.passes;
   const Eigen::VectorXd start = *k;
   FrameSolver solver(energy, options.solver, workspace);  // One Ceres problem for all the passes.
@@ -347,7 +349,7 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
     summary.termination = more.termination;
     summary.trace.insert(summary.trace.end(), more.trace.begin(), more.trace.end());
   }
-  if (passes > 1) {
+  if (passes > 1 && measure_ends) {
     // Both ends by the same sum: the solver's own (Ceres') may differ from it in the last digit.
     EvaluateEnergyAndCost(energy, start, &summary.energy_start, &summary.ls_cost_start);
     EvaluateEnergyAndCost(energy, *k, &summary.energy_end, &summary.ls_cost_end);
@@ -395,7 +397,8 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
     *seconds_preparation += frame.seconds;
     if (k.size() == 0) k = starting_point(&frame);
     TakeTheFrameBefore(input, frame.energy.get());
-    const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
+    const SolverSummary summary =
+        SolveFrameEnergy(frame.energy.get(), level_options, &k, /*measure_ends=*/false);
     totals->AddWork(summary);
   }
   return k;
@@ -429,15 +432,20 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   const Eigen::VectorXd initial = starting_point(&frame);
   Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
   TakeTheFrameBefore(input, frame.energy.get());
-  result.summary = SolveFrameEnergy(frame.energy.get(), options, &k, workspace);
+  // The ends are measured below when a coarser level or the detail stage moved k.
+  const bool detail = UsesSurfaceSamples(options);
+  result.summary =
+      SolveFrameEnergy(frame.energy.get(), options, &k, coarse_k.size() == 0 && !detail, workspace);
   if (coarse_k.size() > 0) {
-    EvaluateEnergyAndCost(frame.energy.get(), initial, &result.summary.energy_start,
-                          &result.summary.ls_cost_start);
-    EvaluateEnergyAndCost(frame.energy.get(), k, &result.summary.energy_end,
-                          &result.summary.ls_cost_end);
+    if (!detail) {
+      EvaluateEnergyAndCost(frame.energy.get(), initial, &result.summary.energy_start,
+                            &result.summary.ls_cost_start);
+      EvaluateEnergyAndCost(frame.energy.get(), k, &result.summary.energy_end,
+                            &result.summary.ls_cost_end);
+    }
     result.summary.AddWork(coarse);
   }
-  if (UsesSurfaceSamples(options)) {
+  if (detail) {
     // The images at their own resolution, from the surface the surface Gaussians found.
     const double seconds = frame.seconds;
     PrepareDetailEnergy(model, input, options, k, &frame);
@@ -445,9 +453,13 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     // The solve of the Gaussians' stage was this energy's first pass.
     frame.energy->EndOfPass(k);
     TakeTheFrameBefore(input, frame.energy.get());
-    SolverSummary summary = SolveFrameEnergy(frame.energy.get(), options, &k);
+    SolverSummary summary =
+        SolveFrameEnergy(frame.energy.get(), options, &k, /*measure_ends=*/false);
     EvaluateEnergyAndCost(frame.energy.get(), initial, &summary.energy_start,
                           &summary.ls_cost_start);
+    if (options.energy.consensus.passes > 1) {
+      EvaluateEnergyAndCost(frame.energy.get(), k, &summary.energy_end, &summary.ls_cost_end);
+    }
     summary.AddWork(result.summary);
     result.summary = summary;
   }

@@ -77,6 +77,11 @@ class DataTerm {
   // residuals at k (without Jacobians) and sums them; a term may know a faster way.
   virtual void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs);
 
+  // H_s = the sum over the residuals r of (dr/dk_s)^2 at k, one entry per unknown (the diagonal
+  // of the Gauss-Newton J^T J). Prepares the residuals with Jacobians
+  // and sums them; a term may know a way that keeps none of them.
+  virtual Eigen::VectorXd GaussNewtonDiagonal(const Eigen::VectorXd& k);
+
   // True when Evaluate(k) is exactly minus half the sum of squares of the residuals at k: then
   // the least-squares cost gives the term's value too, and a solver need not evaluate both.
   virtual bool IsLeastSquares() const { return false; }

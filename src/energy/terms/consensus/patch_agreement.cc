@@ -251,6 +251,27 @@ void PatchAgreementTerm::PrepareResiduals(const Eigen::VectorXd& k, bool with_ja
   }
 }
 
+Eigen::VectorXd PatchAgreementTerm::GaussNewtonDiagonal(const Eigen::VectorXd& k) {
+  Eigen::VectorXd curvature = Eigen::VectorXd::Zero(k.size());
+  const int num_blocks = static_cast<int>(blocks_.size());
+#pragma omp parallel
+  {
+    std::vector<double> residuals, jacobian;
+#pragma omp for schedule(dynamic, 64)
+    for (int b = 0; b < num_blocks; ++b) {
+      const int num_residuals = blocks_[b].num_residuals;
+      residuals.resize(num_residuals);
+      jacobian.resize(num_residuals);
+      PlainResiduals(b, k[blocks_[b].parameters[0]], residuals.data(), jacobian.data());
+      internal::Robustify(LossScale(b), num_residuals, residuals.data(), jacobian.data());
+      // Each block owns one parameter: no two threads write the same entry.
+      double& sum = curvature[blocks_[b].parameters[0]];
+      for (int r = 0; r < num_residuals; ++r) sum += jacobian[r] * jacobian[r];
+    }
+  }
+  return curvature;
+}
+
 void PatchAgreementTerm::BlockResiduals(int block, double* residuals, double* jacobian) const {
   const long begin = residual_begin_[block];
   const int num_residuals = blocks_[block].num_residuals;

@@ -69,6 +69,9 @@ class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
   void PrepareBlockSummaries(const Eigen::VectorXd& k) override;
   // Each block's sum of squares without storing its residuals.
   void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs) override;
+  // Block by block without storing the residuals (a frame's detail stage has millions): the
+  // same sums as DataTerm's, in the same order.
+  Eigen::VectorXd GaussNewtonDiagonal(const Eigen::VectorXd& k) override;
   bool IsLeastSquares() const override { return true; }
   bool ReadsPairLists() const override { return false; }
   PassHook* pass_hook() override { return this; }

@@ -14,12 +14,17 @@ namespace {
 // A patch needs its own sample and at least this many more to have a shape worth comparing.
 constexpr int kMinPatchSamples = 4;
 
-// Writes the bilinear interpolant of a CV_32FC3 image at (x, y), pixel centres at integers, to
-// `color` and, when `derivative` is not null, its derivative along the direction (dx, dy) (that
-// of the interpolant, so that it is exact for the function the solvers see). Outside the image
-// the position is clamped to its border, where the derivative across the border is zero.
-inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, double dy,
-                         double* color, double* derivative) {
+// Where a bilinear read of a CV_32FC3 image at (x, y) reads (pixel centres at integers): the
+// first of the four pixels around it, its offsets u, v from that pixel, and the direction
+// (dx, dy) along which the read's derivative is taken (that of the interpolant, so that it is
+// exact for the function the solvers see). Outside the image the position is clamped to its
+// border, where the derivative across the border is zero.
+struct BilinearCell {
+  const float* top;  // The row below it is `row_step` floats on.
+  double u, v, dx, dy;
+};
+
+inline BilinearCell CellAt(const cv::Mat& image, double x, double y, double dx, double dy) {
   const double max_x = image.cols - 1.0, max_y = image.rows - 1.0;
   if (!(x > 0.0 && x < max_x)) {
     x = std::clamp(x, 0.0, max_x);
@@ -31,34 +36,57 @@ inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, do
   }
   const int x0 = std::min(static_cast<int>(x), image.cols - 2);
   const int y0 = std::min(static_cast<int>(y), image.rows - 2);
-  const double u = x - x0, v = y - y0;
-  const float* top = image.ptr<float>(y0) + 3 * x0;
-  const float* bottom = image.ptr<float>(y0 + 1) + 3 * x0;
+  return {image.ptr<float>(y0) + 3 * x0, x - x0, y - y0, dx, dy};
+}
+
+// Writes the bilinear interpolant at `cell` (three channels) to `color` and, when `derivative` is
+// not null, its derivative along the cell's direction to it; `row_step` floats from one image row
+// to the next.
+inline void ReadCell(const BilinearCell& cell, long row_step, double* color, double* derivative) {
+  const float* top = cell.top;
+  const float* bottom = top + row_step;
   for (int channel = 0; channel < 3; ++channel) {
     const double c00 = top[channel], c10 = top[channel + 3];
     const double c01 = bottom[channel], c11 = bottom[channel + 3];
     const double along_top = c10 - c00, along_bottom = c11 - c01;
-    const double upper = c00 + u * along_top, lower = c01 + u * along_bottom;
-    color[channel] = upper + v * (lower - upper);
+    const double upper = c00 + cell.u * along_top, lower = c01 + cell.u * along_bottom;
+    color[channel] = upper + cell.v * (lower - upper);
     if (derivative != nullptr) {
       derivative[channel] =
-          dx * (along_top + v * (along_bottom - along_top)) + dy * (lower - upper);
+          cell.dx * (along_top + cell.v * (along_bottom - along_top)) + cell.dy * (lower - upper);
     }
   }
 }
 
-// The homogeneous pixel of camera `projection` of a sample at `base` moved by `k` along `normal`,
-// and its k-derivative (a straight line).
-inline void ProjectSample(const Eigen::Matrix<double, 3, 4>& projection,
-                          const Eigen::Vector3d& base, const Eigen::Vector3d& normal, double k,
-                          double* x, double* y, double* dx, double* dy) {
-  const Eigen::Vector3d direction = projection.leftCols<3>() * normal;
-  const Eigen::Vector3d h = projection.leftCols<3>() * base + projection.col(3) + k * direction;
+// Floats from one row of a CV_32FC3 image to the next.
+inline long RowStep(const cv::Mat& image) { return static_cast<long>(image.step1()); }
+
+// The bilinear interpolant of a CV_32FC3 image at (x, y), as CellAt and ReadCell.
+inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, double dy,
+                         double* color, double* derivative) {
+  ReadCell(CellAt(image, x, y, dx, dy), RowStep(image), color, derivative);
+}
+
+// The pixel of the homogeneous pixel `at_zero` + k `direction` (a sample's projection moved by k
+// along its normal: a straight line), and its k-derivative.
+inline void PixelOnRay(const Eigen::Vector3d& at_zero, const Eigen::Vector3d& direction, double k,
+                       double* x, double* y, double* dx, double* dy) {
+  const Eigen::Vector3d h = at_zero + k * direction;
   const double inverse_depth = 1.0 / h.z();
   *x = h.x() * inverse_depth;
   *y = h.y() * inverse_depth;
   *dx = (direction.x() - *x * direction.z()) * inverse_depth;
   *dy = (direction.y() - *y * direction.z()) * inverse_depth;
+}
+
+// The homogeneous pixel of camera `projection` of a sample at `base` moved by `k` along `normal`,
+// and its k-derivative.
+inline void ProjectSample(const Eigen::Matrix<double, 3, 4>& projection,
+                          const Eigen::Vector3d& base, const Eigen::Vector3d& normal, double k,
+                          double* x, double* y, double* dx, double* dy) {
+  const Eigen::Vector3d direction = projection.leftCols<3>() * normal;
+  const Eigen::Vector3d at_zero = projection.leftCols<3>() * base + projection.col(3);
+  PixelOnRay(at_zero, direction, k, x, y, dx, dy);
 }
 
 Eigen::Matrix<double, 3, 4> ProjectionOf(const Camera& camera) {
@@ -136,6 +164,7 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
   }
   shape_ = Eigen::VectorXd::Zero(samples.size());
   parameter_shape_ = Eigen::VectorXd::Zero(samples.patches.size());
+  ProjectReads();
   WeighPatches();
 }
 
@@ -184,14 +213,28 @@ bool PixelConsensusSimilarity::AppearanceKnown(const std::vector<int>& members) 
                      [&](int j) { return samples_.appearance.col(j).allFinite(); });
 }
 
-void PixelConsensusSimilarity::SampleColor(int c, int j, double k, double* color,
-                                           double* derivative) const {
-  // The sample's homogeneous pixel h(k) = P (base + k normal): a straight line, so that the pixel
-  // h_xy / h_z and its k-derivative (h'_xy - pixel h'_z) / h_z need no more than it.
-  double x, y, dx, dy;
-  ProjectSample(projections_[c], samples_.base.col(j), samples_.normals.col(j), k, &x, &y, &dx,
-                &dy);
-  ReadBilinear(cameras_[c].pixels, x, y, dx, dy, color, derivative);
+void PixelConsensusSimilarity::ProjectReads() {
+  const int num_blocks = static_cast<int>(blocks_.size());
+  read_begin_.assign(1, 0);
+  for (int b = 0; b < num_blocks; ++b) {
+    read_begin_.push_back(read_begin_.back() + static_cast<long>(PatchSize(b)) * NumCameras(b));
+  }
+  rays_.resize(read_begin_.back());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (int b = 0; b < num_blocks; ++b) {
+    const int n = PatchSize(b), num_cameras = NumCameras(b);
+    const int* members = Members(b);
+    for (int a = 0; a < num_cameras; ++a) {
+      const int c = Cameras(b)[a];
+      if (c == appearance_view_) continue;
+      const Eigen::Matrix<double, 3, 4>& projection = projections_[c];
+      for (int m = 0; m < n; ++m) {
+        SampleRay& ray = rays_[read_begin_[b] + a * n + m];
+        ray.direction = projection.leftCols<3>() * samples_.normals.col(members[m]);
+        ray.at_zero = projection.leftCols<3>() * samples_.base.col(members[m]) + projection.col(3);
+      }
+    }
+  }
 }
 
 void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
@@ -199,6 +242,12 @@ void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
   const int n = PatchSize(b), num_cameras = NumCameras(b);
   const int* members = Members(b);
   const double centre_shape = parameter_shape_[blocks_[b].parameters[0]];
+  // A member's displacement is the same in every camera.
+  thread_local std::vector<double> member_k;
+  thread_local std::vector<BilinearCell> cells;
+  member_k.resize(n);
+  cells.resize(n);
+  for (int m = 0; m < n; ++m) member_k[m] = k + shape_[members[m]] - centre_shape;
   for (int a = 0; a < num_cameras; ++a) {
     const int c = Cameras(b)[a];
     if (c == appearance_view_) {
@@ -212,10 +261,24 @@ void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
       }
       continue;
     }
+    // The sample's homogeneous pixel h(k) = P (base + k normal) is a straight line, so that the
+    // pixel h_xy / h_z and its k-derivative (h'_xy - pixel h'_z) / h_z need no more than it.
+    // Every member's cell first and its pixels asked of memory, then the reads: the image is
+    // mostly not in the nearest caches, and the reads' waits then overlap.
+    const SampleRay* rays = &rays_[read_begin_[b] + a * n];
+    const cv::Mat& image = cameras_[c].pixels;
+    const long row_step = RowStep(image);
+    for (int m = 0; m < n; ++m) {
+      double x, y, dx, dy;
+      PixelOnRay(rays[m].at_zero, rays[m].direction, member_k[m], &x, &y, &dx, &dy);
+      cells[m] = CellAt(image, x, y, dx, dy);
+      __builtin_prefetch(cells[m].top);
+      __builtin_prefetch(cells[m].top + row_step);
+    }
     for (int m = 0; m < n; ++m) {
       const int i = a * n + m;
-      SampleColor(c, members[m], k + shape_[members[m]] - centre_shape, colors + 3 * i,
-                  derivatives != nullptr ? derivatives + 3 * i : nullptr);
+      ReadCell(cells[m], row_step, colors + 3 * i,
+               derivatives != nullptr ? derivatives + 3 * i : nullptr);
     }
   }
 }

@@ -67,9 +67,8 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // (CameraInput::samples_on_foreground); with no masks, every camera that sees it, on all of it.
   void ComparablePart(const std::vector<int>& patch, std::vector<int>* seen_by,
                       std::vector<int>* members) const;
-  // Writes camera c's colour of sample j displaced by k along its normal (three channels) to
-  // `color` and, when `derivative` is not null, dcolour/dk to it.
-  void SampleColor(int c, int j, double k, double* color, double* derivative) const;
+  // Sets rays_ for every block's reads.
+  void ProjectReads();
 
   // Whether the patch's members all have a known appearance (SurfaceSamples::appearance).
   bool AppearanceKnown(const std::vector<int>& members) const;
@@ -81,6 +80,18 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   int appearance_view_;
   // Per camera, K [R | t]: the homogeneous pixel of a world point (the images are undistorted).
   std::vector<Eigen::Matrix<double, 3, 4>> projections_;
+  // A sample read by a camera: its homogeneous pixel at the input surface and that pixel's
+  // derivative along the sample's normal, so that a read moved by k costs three multiply-adds
+  // before the division instead of two matrix products. Per block, camera after camera, member
+  // after member (the order of PatchColors), from read_begin_[b]; none is read for the
+  // appearance's view. Laid out in the order the evaluation reads them, they stream from memory,
+  // where the samples' positions and normals were gathered from all over theirs.
+  struct SampleRay {
+    Eigen::Vector3d at_zero;
+    Eigen::Vector3d direction;
+  };
+  std::vector<SampleRay> rays_;
+  std::vector<long> read_begin_;
   Eigen::VectorXd shape_;            // Per sample.
   Eigen::VectorXd parameter_shape_;  // Per surface Gaussian.
 };

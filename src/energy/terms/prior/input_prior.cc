@@ -7,23 +7,7 @@
 namespace finecap {
 
 Eigen::VectorXd DataCurvature(DataTerm* term, const Eigen::VectorXd& k) {
-  term->PrepareResiduals(k, true);
-  Eigen::VectorXd curvature = Eigen::VectorXd::Zero(k.size());
-  std::vector<double> residuals, jacobian;
-  const auto& blocks = term->residual_blocks();
-  for (int b = 0; b < static_cast<int>(blocks.size()); ++b) {
-    const int num_parameters = static_cast<int>(blocks[b].parameters.size());
-    residuals.resize(blocks[b].num_residuals);
-    jacobian.resize(blocks[b].num_residuals * num_parameters);
-    term->BlockResiduals(b, residuals.data(), jacobian.data());
-    for (int r = 0; r < blocks[b].num_residuals; ++r) {
-      for (int p = 0; p < num_parameters; ++p) {
-        const double derivative = jacobian[r * num_parameters + p];
-        curvature[blocks[b].parameters[p]] += derivative * derivative;
-      }
-    }
-  }
-  return curvature;
+  return term->GaussNewtonDiagonal(k);
 }
 
 namespace {
