@@ -390,7 +390,7 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
         PrepareLevel(model, level_colors, input, level_options,
                      FrameImageModels(input, level_options.image), sweeps && k.size() == 0);
     *seconds_preparation += frame.seconds;
-    k = k.size() == 0 ? starting_point(&frame) : WithinRange(k, frame.k_max);
+    k = WithinRange(k.size() == 0 ? starting_point(&frame) : k, frame.k_max);
     TakeTheFrameBefore(input, frame.energy.get());
     const SolverSummary summary = SolveFrameEnergy(frame.energy.get(), level_options, &k);
     totals->AddWork(summary);
@@ -424,8 +424,9 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
   result.num_pairs = frame.energy->num_pairs();
   result.seconds_preparation += frame.seconds;
 
-  // The frame got worse or better against where it started, before any level moved it.
-  const Eigen::VectorXd initial = starting_point(&frame);
+  // The frame got worse or better against where it started, before any level moved it. A start
+  // handed in (the frame before's k) may lie in a range this frame did not widen to.
+  const Eigen::VectorXd initial = WithinRange(starting_point(&frame), frame.k_max);
   Eigen::VectorXd k = coarse_k.size() > 0 ? WithinRange(coarse_k, frame.k_max) : initial;
   TakeTheFrameBefore(input, frame.energy.get());
   result.summary = SolveFrameEnergy(frame.energy.get(), options, &k, workspace);

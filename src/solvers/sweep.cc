@@ -95,7 +95,9 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
     // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
     if (costs.row(s).minCoeff() == costs.row(s).maxCoeff()) continue;
     const int best = WindowedMinimum(costs.row(s), displacements, window);
-    at_ends += best == 0 || best == last;
+    // Where the images cannot decide k a curve at an end says nothing of the range.
+    const bool confident = energy->confidence().size() != n || energy->confidence()[s] >= 0.5;
+    at_ends += confident && (best == 0 || best == last);
     result.k[s] = displacements[best];
     // Sub-sample position: the vertex of the parabola through the best sample and its neighbours.
     if (best > 0 && best < last) {

@@ -67,9 +67,9 @@ int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
 // A sweep's start and what it says about its range.
 struct SweepResult {
   Eigen::VectorXd k;  // One entry per surface Gaussian, metres.
-  // The share of the Gaussians (those whose curve is flat counted too) whose window grew to the
-  // whole range and whose best sample is at one of its ends: where the range, not the images,
-  // limits them.
+  // The share of the Gaussians (those whose curve is flat counted too) refined with confidence
+  // (FrameEnergy::confidence() at least 0.5) whose window grew to the whole range and whose best
+  // sample is at one of its ends: where the range, not the images, limits them.
   double share_at_ends = 0.0;
 };
 
