@@ -52,6 +52,68 @@ TEST(SweepTest, StartsLieWithinTheSweptRange) {
   }
 }
 
+// Displacements -8 .. 8 (17 samples) and a window of 2 each side of 0.
+Eigen::VectorXd Displacements() { return Eigen::VectorXd::LinSpaced(17, -8.0, 8.0); }
+
+// A cost that falls all the way to the upper end of the window and on beyond it: the window
+// widens until the minimum (at 6) lies inside it.
+TEST(WindowedMinimumTest, ACostFallingBeyondTheWindowWidensIt) {
+  const Eigen::VectorXd k = Displacements();
+  const Eigen::RowVectorXd costs = (k.array() - 6.0).square().matrix().transpose();
+  EXPECT_DOUBLE_EQ(k[WindowedMinimum(costs, k, 2.0)], 6.0);
+}
+
+// A minimum inside the window (at -1) is kept although a deeper one lies outside it (at 6).
+TEST(WindowedMinimumTest, AMinimumInsideTheWindowIsKept) {
+  const Eigen::VectorXd k = Displacements();
+  const Eigen::RowVectorXd costs =
+      (-Eigen::exp(-(k.array() + 1.0).square()) - 2.0 * Eigen::exp(-(k.array() - 6.0).square()))
+          .matrix()
+          .transpose();
+  EXPECT_DOUBLE_EQ(k[WindowedMinimum(costs, k, 2.0)], -1.0);
+  // The whole range at once takes the deeper one.
+  EXPECT_DOUBLE_EQ(k[WindowedMinimum(costs, k, 8.0)], 6.0);
+}
+
+// The lowest cost at the window's end, but higher beyond it: the window stays, and the start is
+// its end.
+TEST(WindowedMinimumTest, AnEndLowerThanWhatLiesBeyondIsKept) {
+  const Eigen::VectorXd k = Displacements();
+  Eigen::RowVectorXd costs = (k.array() - 2.0).square().matrix().transpose();
+  costs.tail(5).setConstant(0.5);  // 4 .. 8: above the cost at 2 (0), beyond the window.
+  EXPECT_DOUBLE_EQ(k[WindowedMinimum(costs, k, 2.0)], 2.0);
+}
+
+// A cost that keeps falling to the end of the range stops there, whatever the window.
+TEST(WindowedMinimumTest, ACostFallingToTheRangesEndStopsThere) {
+  const Eigen::VectorXd k = Displacements();
+  const Eigen::RowVectorXd costs = (-k.array()).matrix().transpose();
+  EXPECT_EQ(WindowedMinimum(costs, k, 2.0), 16);
+  EXPECT_EQ(WindowedMinimum((-costs).eval(), k, 0.5), 0);
+}
+
+// The share of Gaussians the range limits counts those whose start is at an end of the range:
+// with the range so narrow that the costs cannot turn (one sample each side of 0 and the input
+// off by more), some are; with a wide range fewer.
+TEST(SweepTest, ANarrowRangeLimitsMoreGaussians) {
+  const EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  SweepOptions sweep;
+  sweep.samples = 9;
+  sweep.max_step_sigmas = 0.0;
+  double share[2];
+  for (int wide = 0; wide < 2; ++wide) {
+    EnergyOptions options = SweepEnergyOptions(SimilarityType::kConsensus);
+    options.k_max = wide ? 0.01 : 1e-4;
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+    const SweepResult result = Sweep(&energy, sweep);
+    int at_ends = 0;
+    for (int s = 0; s < result.k.size(); ++s) at_ends += std::abs(result.k[s]) == options.k_max;
+    EXPECT_DOUBLE_EQ(result.share_at_ends, static_cast<double>(at_ends) / result.k.size());
+    share[wide] = result.share_at_ends;
+  }
+  EXPECT_GT(share[0], share[1]);
+}
+
 TEST(SweepTest, SweepOffStartsEveryGaussianAtZero) {
   const EnergyScene scene = MakeEnergyScene({0.0, 0.6}, 2, 3);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,

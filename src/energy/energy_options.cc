@@ -36,8 +36,10 @@ const OptionFields<EnergyOptions>& EnergyOptions::Fields() {
     f.AddDouble("reach_sigmas", &EnergyOptions::reach_sigmas,
                 "Pairs of Gaussians are evaluated up to this many combined sigmas apart.", 0.5,
                 10.0);
-    f.AddDouble("k_max", &EnergyOptions::k_max, "Bound on the displacement along the normal, m",
-                1e-5, 1.0);
+    f.AddDouble("k_max", &EnergyOptions::k_max,
+                "Bound on the displacement along the normal, m; a frame whose plane sweep finds "
+                "it limiting doubles it (refine.sweep.widen_share).",
+                1e-5, kLargestKMax);
     f.AddDouble("w_reg", &EnergyOptions::w_reg, "Weight of the regulariser (paper: 1).", 0.0, 1e12);
     f.AddDouble("w_prior", &EnergyOptions::w_prior,
                 "Weight of a pull of k towards the input surface (not in the paper); keeps "

@@ -9,6 +9,7 @@
 #include "finecap/energy/frame_energy.h"
 #include "finecap/energy/similarity_needs.h"
 #include "finecap/geometry/render.h"
+#include "finecap/solvers/sweep.h"
 #include "finecap/util/error.h"
 #include "refine/foreground.h"
 #include "refine/surface_sampling.h"
@@ -180,12 +181,35 @@ std::vector<double> InputOffsets(const SequenceModel& model, const Mesh& coarse,
   return offsets;
 }
 
+// Builds the energy of `surface` over `cameras` and, when `sweep`, finds the plane sweep's start
+// (frame->sweep_start), doubling the frame's range and building the energy again while the sweep
+// says that the range limits it (SweepOptions::widen_share). frame->k_max is the range used.
+void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surface,
+                      const std::vector<CameraInput>& cameras, const RefineOptions& options,
+                      bool sweep, PreparedFrame* frame) {
+  EnergyOptions energy = EnergyOptionsAt(options);
+  for (int widenings = 0;; ++widenings) {
+    frame->energy = std::make_unique<FrameEnergy>(surface, cameras, model.neighbourhoods(), energy);
+    frame->k_max = energy.k_max;
+    if (!sweep) return;
+    SweepResult start = Sweep(frame->energy.get(), options.sweep);
+    const bool limited =
+        options.sweep.widen_share > 0.0 && start.share_at_ends > options.sweep.widen_share &&
+        widenings < options.sweep.max_widenings && energy.k_max < EnergyOptions::kLargestKMax;
+    if (!limited) {
+      frame->sweep_start = std::move(start.k);
+      return;
+    }
+    energy.k_max = std::min(2.0 * energy.k_max, EnergyOptions::kLargestKMax);
+  }
+}
+
 // PrepareFrame without checking `options`, over the image models `images` of the input's images
 // under options.image: the coarse levels of a schedule widen sigma_hat and the leaves past the
-// ranges that a configured value must lie in.
+// ranges that a configured value must lie in. With `sweep`, also the plane sweep's start.
 PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options,
-                           std::vector<ImageGaussians> images) {
+                           std::vector<ImageGaussians> images, bool sweep) {
   const auto start = std::chrono::steady_clock::now();
   PreparedFrame frame;
   frame.fine = model.Subdivide(input.coarse);
@@ -227,8 +251,7 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
     frame.num_image_gaussians += frame.images[c].size();
   }
-  frame.energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                               EnergyOptionsAt(options));
+  BuildSweptEnergy(model, surface, cameras, options, sweep && options.sweep.samples > 0, &frame);
   if (!frame.energy->ReadsPairLists()) std::vector<ImageGaussians>().swap(frame.images);
   frame.seconds = SecondsSince(start);
   return frame;
@@ -239,7 +262,8 @@ PreparedFrame PrepareLevel(const SequenceModel& model, const ReferenceColors& co
 PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& colors,
                            const FrameInput& input, const RefineOptions& options) {
   options.Check();
-  return PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image));
+  return PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image),
+                      /*sweep=*/false);
 }
 
 PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColors& colors,
@@ -248,10 +272,8 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
   const auto start = std::chrono::steady_clock::now();
   ModelFrameImages(options.image, input);
   PreparedFrame frame =
-      PrepareLevel(model, colors, *input, options, std::exchange(input->image_models, {}));
-  if (options.coarse_to_fine.levels == 1) {
-    frame.sweep_start = SweepInitialization(frame.energy.get(), options.sweep);
-  }
+      PrepareLevel(model, colors, *input, options, std::exchange(input->image_models, {}),
+                   /*sweep=*/options.coarse_to_fine.levels == 1);
   frame.seconds = SecondsSince(start);
   return frame;
 }
@@ -316,8 +338,10 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     }
     cameras[c].pixels = pixels[c];
   }
+  EnergyOptions energy = EnergyOptionsAt(options);
+  energy.k_max = frame->k_max;  // The range the surface Gaussians' stage was solved in.
   frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
-                                                EnergyOptionsAt(options), std::move(samples));
+                                                energy, std::move(samples));
   frame->seconds += SecondsSince(start);
 }
 
@@ -364,6 +388,11 @@ void TakeTheFrameBefore(const FrameInput& input, FrameEnergy* energy) {
   energy->TakeFrameBefore(energy->UnknownsAtVertices(input.frame_before_k));
 }
 
+// `k` clamped to [-k_max, k_max]: a coarser level's range may have been widened further.
+Eigen::VectorXd WithinRange(const Eigen::VectorXd& k, double k_max) {
+  return k.cwiseMax(-k_max).cwiseMin(k_max);
+}
+
 // Where the solve of a prepared frame starts: one k per surface Gaussian of its energy.
 using StartingPointFunction = std::function<Eigen::VectorXd(PreparedFrame* frame)>;
 
@@ -382,20 +411,22 @@ RefineOptions LevelOptions(const RefineOptions& options, int level) {
 }
 
 // The coarse levels of the schedule, coarsest first, each starting where the last one ended.
-// Returns the k to start the configured level from; adds the work done to *totals.
+// Returns the k to start the configured level from; adds the work done to *totals. `sweeps`: the
+// starting point is the plane sweep's (PrepareLevel).
 Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
-                                  const StartingPointFunction& starting_point,
+                                  const StartingPointFunction& starting_point, bool sweeps,
                                   SolverSummary* totals, double* seconds_preparation) {
   Eigen::VectorXd k;
   for (int level = options.coarse_to_fine.levels - 1; level >= 1; --level) {
     const RefineOptions level_options = LevelOptions(options, level);
     ReferenceColors level_colors = colors;
     level_colors.sigma_hat = colors.sigma_hat * level_options.sigma_hat / options.sigma_hat;
-    PreparedFrame frame = PrepareLevel(model, level_colors, input, level_options,
-                                       FrameImageModels(input, level_options.image));
+    PreparedFrame frame =
+        PrepareLevel(model, level_colors, input, level_options,
+                     FrameImageModels(input, level_options.image), sweeps && k.size() == 0);
     *seconds_preparation += frame.seconds;
-    if (k.size() == 0) k = starting_point(&frame);
+    k = WithinRange(k.size() == 0 ? starting_point(&frame) : k, frame.k_max);
     TakeTheFrameBefore(input, frame.energy.get());
     const SolverSummary summary =
         SolveFrameEnergy(frame.energy.get(), level_options, &k, /*measure_ends=*/false);
@@ -406,31 +437,34 @@ Eigen::VectorXd SolveCoarseLevels(const SequenceModel& model, const ReferenceCol
 
 // RefineFrame, starting each level that does not continue from a coarser one at
 // `starting_point`; the configured level is `ahead` when that is not empty, and is solved in
-// `workspace` (the coarser levels, whose problems differ from it, in their own).
+// `workspace` (the coarser levels, whose problems differ from it, in their own). `sweeps`: the
+// starting point is the plane sweep's, found as a level is prepared (PrepareLevel).
 FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceColors& colors,
                                   const FrameInput& input, const RefineOptions& options,
-                                  const StartingPointFunction& starting_point, PreparedFrame ahead,
-                                  SolverWorkspace* workspace) {
+                                  const StartingPointFunction& starting_point, bool sweeps,
+                                  PreparedFrame ahead, SolverWorkspace* workspace) {
   options.Check();
   const auto start = std::chrono::steady_clock::now();
   FrameResult result;
   SolverSummary coarse;
   const Eigen::VectorXd coarse_k = SolveCoarseLevels(model, colors, input, options, starting_point,
-                                                     &coarse, &result.seconds_preparation);
+                                                     sweeps, &coarse, &result.seconds_preparation);
 
   result.prepared_ahead = ahead.energy != nullptr;
-  PreparedFrame frame =
-      result.prepared_ahead
-          ? std::move(ahead)
-          : PrepareLevel(model, colors, input, options, FrameImageModels(input, options.image));
+  PreparedFrame frame = result.prepared_ahead
+                            ? std::move(ahead)
+                            : PrepareLevel(model, colors, input, options,
+                                           FrameImageModels(input, options.image), sweeps);
   result.num_surface_gaussians = frame.energy->num_parameters();
+  result.k_max = frame.k_max;
   result.num_image_gaussians = frame.num_image_gaussians;
   result.num_pairs = frame.energy->num_pairs();
   result.seconds_preparation += frame.seconds;
 
-  // The frame got worse or better against where it started, before any level moved it.
-  const Eigen::VectorXd initial = starting_point(&frame);
-  Eigen::VectorXd k = coarse_k.size() > 0 ? coarse_k : initial;
+  // The frame got worse or better against where it started, before any level moved it. A start
+  // handed in (the frame before's k) may lie in a range this frame did not widen to.
+  const Eigen::VectorXd initial = WithinRange(starting_point(&frame), frame.k_max);
+  Eigen::VectorXd k = coarse_k.size() > 0 ? WithinRange(coarse_k, frame.k_max) : initial;
   TakeTheFrameBefore(input, frame.energy.get());
   // The ends are measured below when a coarser level or the detail stage moved k.
   const bool detail = UsesSurfaceSamples(options);
@@ -541,7 +575,7 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
   return RefineFrameStartingAt(
       model, colors, input, options,
       [&](PreparedFrame* frame) { return StartingPoint(frame, options.sweep, warm_start); },
-      std::move(ahead), workspace);
+      /*sweeps=*/warm_start == nullptr || warm_start->size() == 0, std::move(ahead), workspace);
 }
 
 FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& colors,
@@ -561,7 +595,7 @@ FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& c
         }
         return k;
       },
-      std::move(ahead), workspace);
+      /*sweeps=*/true, std::move(ahead), workspace);
 }
 
 }  // namespace finecap

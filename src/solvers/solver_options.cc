@@ -88,6 +88,23 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
                   kMinSamples, kMaxSamples);
     f.AddInt("smoothing_rounds", &SweepOptions::smoothing_rounds,
              "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0, 1000);
+    f.AddDouble("window_sigmas", &SweepOptions::window_sigmas,
+                "Plane-sweep start: each surface Gaussian first looks for its lowest cost within "
+                "this many model.sigma_hat of the input, and doubles its window only while that "
+                "cost is at the window's end and falls further beyond it (0: the whole range).",
+                0.0, 1e4);
+    f.AddDouble("max_step_sigmas", &SweepOptions::max_step_sigmas,
+                "Plane-sweep start: the displacements tried are at most this many "
+                "model.sigma_hat apart, more of them than `samples` on a wide range (0: "
+                "`samples` alone).",
+                0.0, 100.0);
+    f.AddDouble("widen_share", &SweepOptions::widen_share,
+                "Plane-sweep start: a frame's range (energy.k_max) doubles while more than this "
+                "share of its surface Gaussians finds its lowest cost at an end of the range "
+                "(0: never widen).",
+                0.0, 1.0);
+    f.AddInt("max_widenings", &SweepOptions::max_widenings,
+             "Plane-sweep start: doublings of a frame's range (energy.k_max) at most.", 0, 20);
     return f;
   }();
   return fields;

@@ -1,5 +1,7 @@
 #include "finecap/solvers/sweep.h"
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "finecap/util/error.h"
@@ -31,35 +33,85 @@ Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& dis
   return costs;
 }
 
+// The samples, evenly spaced over [-k_max, k_max], an odd number of them (k = 0 among them) when
+// max_step_sigmas sets their number.
+Eigen::VectorXd SweepDisplacements(const SweepOptions& options, double k_max, double sigma_hat) {
+  int samples = options.samples;
+  if (options.max_step_sigmas > 0.0) {
+    const double half = std::ceil(k_max / (options.max_step_sigmas * sigma_hat));
+    samples = std::max(samples,
+                       1 + 2 * static_cast<int>(std::min(half, 0.5 * SweepOptions::kMaxSamples)));
+  }
+  return Eigen::VectorXd::LinSpaced(samples, -k_max, k_max);
+}
+
 }  // namespace
 
-Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options) {
+int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
+                    const Eigen::Ref<const Eigen::VectorXd>& displacements, double window) {
+  const int n = static_cast<int>(costs.size());
+  const double tolerance = 1e-9 * (displacements[n - 1] - displacements[0]);
+  // The samples within `reach` of k = 0: [first, last].
+  const auto samples_within = [&](double reach, int* first, int* last) {
+    *first = 0;
+    *last = n - 1;
+    while (*first < n - 1 && displacements[*first] < -reach - tolerance) ++*first;
+    while (*last > *first && displacements[*last] > reach + tolerance) --*last;
+  };
+  for (double reach = window;; reach *= 2.0) {
+    int first = 0, last = 0;
+    samples_within(reach, &first, &last);
+    int best = 0;
+    const double low = costs.segment(first, last - first + 1).minCoeff(&best);
+    best += first;
+    const bool at_lower_end = best == first && first > 0;
+    const bool at_upper_end = best == last && last + 1 < n;
+    if (!at_lower_end && !at_upper_end) return best;
+    int wide_first = 0, wide_last = 0;
+    samples_within(2.0 * reach, &wide_first, &wide_last);
+    const double beyond = at_lower_end ? costs.segment(wide_first, first - wide_first).minCoeff()
+                                       : costs.segment(last + 1, wide_last - last).minCoeff();
+    if (!(beyond < low)) return best;
+  }
+}
+
+SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   options.Check();
   const int n = energy->num_parameters();
-  if (options.samples == 0) return Eigen::VectorXd::Zero(n);
+  SweepResult result;
+  result.k = Eigen::VectorXd::Zero(n);
+  if (options.samples == 0 || n == 0) return result;
   const double k_max = energy->layout().bound;
-  const Eigen::VectorXd displacements = Eigen::VectorXd::LinSpaced(options.samples, -k_max, k_max);
+  const double sigma_hat = energy->surface().sigma_hat;
+  const Eigen::VectorXd displacements = SweepDisplacements(options, k_max, sigma_hat);
+  const double window = options.window_sigmas > 0.0 ? options.window_sigmas * sigma_hat : k_max;
   Eigen::MatrixXd costs = CostsPerGaussian(energy, displacements);
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];
-  Eigen::VectorXd k(n);
+  const int last = static_cast<int>(displacements.size()) - 1;
+  int at_ends = 0;
   for (int s = 0; s < n; ++s) {
-    int best = 0;
     // A Gaussian whose curve is flat (no block reaches it, nor its neighbours' costs) has no
     // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
-    if (costs.row(s).minCoeff(&best) == costs.row(s).maxCoeff()) {
-      k[s] = 0.0;
-      continue;
-    }
-    k[s] = displacements[best];
+    if (costs.row(s).minCoeff() == costs.row(s).maxCoeff()) continue;
+    const int best = WindowedMinimum(costs.row(s), displacements, window);
+    // Where the images cannot decide k a curve at an end says nothing of the range.
+    const bool confident = energy->confidence().size() != n || energy->confidence()[s] >= 0.5;
+    at_ends += confident && (best == 0 || best == last);
+    result.k[s] = displacements[best];
     // Sub-sample position: the vertex of the parabola through the best sample and its neighbours.
-    if (best > 0 && best + 1 < displacements.size()) {
+    if (best > 0 && best < last) {
       const double c0 = costs(s, best - 1), c1 = costs(s, best), c2 = costs(s, best + 1);
       const double curvature = c0 - 2.0 * c1 + c2;
-      if (curvature > 0.0) k[s] += 0.5 * step * (c0 - c2) / curvature;
+      if (curvature > 0.0) result.k[s] += 0.5 * step * (c0 - c2) / curvature;
     }
   }
-  return k;
+  result.share_at_ends = static_cast<double>(at_ends) / n;
+  return result;
+}
+
+Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options) {
+  return Sweep(energy, options).k;
 }
 
 }  // namespace finecap

@@ -83,7 +83,9 @@ struct EnergyOptions {
   double color_cutoff = 0.05;
   // Combined: sqrt(sigma_s^2 + sigma_i^2), for some allowed k.
   double reach_sigmas = 3.0;
-  // A refinement makes it follow from the scene unless set (RefineOptions::scene_lengths).
+  // A refinement makes it follow from the scene unless set (RefineOptions::scene_lengths), and
+  // widens it for a frame whose plane sweep finds it limiting (SweepOptions::widen_share).
+  static constexpr double kLargestKMax = 1.0;
   double k_max = 0.02;
   // The paper's 1 is with k in millimetres inside E_reg, and its E_sim. 1e-6 for the consensus
   // similarity, whose residuals are contrast-weighted normalised patches (~0.01-0.1);

@@ -41,6 +41,9 @@ struct FrameStats {
   // The share of the refined vertices refined with confidence (ConfidentShare, refine.h), in
   // [0, 1]: where the rest lie, the confidence pull keeps the input. Low on a sparse rig.
   double confident_share = std::numeric_limits<double>::quiet_NaN();
+  // The range of the displacements the frame was solved in (energy.k_max, or wider where its
+  // plane sweep found that limiting), millimetres.
+  double k_max_mm = std::numeric_limits<double>::quiet_NaN();
   long image_gaussians = 0;
   long pairs = 0;
   bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.

@@ -255,6 +255,9 @@ struct PreparedFrame {
   // The plane sweep's start over `energy` (SweepInitialization), when it was found ahead of the
   // solve (PrepareFrameAhead); empty otherwise.
   Eigen::VectorXd sweep_start;
+  // The range of `energy`'s displacements: EnergyOptions::k_max, or wider where the plane sweep
+  // found it limiting (SweepOptions::widen_share).
+  double k_max = 0.0;
   long num_image_gaussians = 0;
   double seconds = 0.0;  // The preparation's, the sweep's included.
 };
@@ -305,6 +308,7 @@ struct FrameResult {
   bool kept_input = false;  // The input surface was written instead (keep_input_if_worse, or no
                             // camera sees any refined vertex).
   int num_surface_gaussians = 0;
+  double k_max = 0.0;  // The range it was solved in (PreparedFrame::k_max), metres.
   long num_image_gaussians = 0;
   long num_pairs = 0;
   double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
