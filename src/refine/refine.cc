@@ -281,17 +281,21 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
 namespace {
 
 // Per camera, which vertices of `frame.fine` the detail stage reads it for: the cameras that see
-// the surface the surface Gaussians found (`found`, smoothed as the patches' shape will be,
-// PatchAgreementTerm::EndOfPass) within VisibilityOptions::sample_view_angle_deg of its normals,
-// by the geometry alone.
+// the surface the surface Gaussians found (`found`, smoothed as the patches' shape will be at
+// level 1, PatchAgreementTerm::EndOfPass, over the same reach at finer levels) within
+// VisibilityOptions::sample_view_angle_deg of its normals, by the geometry alone.
 std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& frame,
                                                          const Eigen::VectorXd& found,
                                                          const FrameInput& input,
                                                          const RefineOptions& options) {
   const FrameEnergy& energy = *frame.energy;
   Eigen::MatrixXd shape = found;
-  energy.regularizer().AverageOverNeighbours(options.energy.consensus.shape_smoothing_rounds,
-                                             &shape);
+  // The rounds count on the input subdivided once, as the patches' rings do (PatchRingsAt): an
+  // average's reach grows as the square root of its rounds, so each further level, whose edges
+  // are half as long, takes four times as many.
+  const int doublings = std::max(options.subdivision_levels - 1, 0);
+  const int rounds = options.energy.consensus.shape_smoothing_rounds << (2 * doublings);
+  energy.regularizer().AverageOverNeighbours(rounds, &shape);
   Mesh surface = frame.fine;
   const std::vector<int>& ids = energy.surface().vertex_ids;
   for (size_t s = 0; s < ids.size(); ++s) {
