@@ -73,6 +73,16 @@ class FrontalViewsTest : public ::testing::Test {
   std::vector<int> Kept(int wanted) const {
     std::vector<std::vector<unsigned char>> visible(3, std::vector<unsigned char>(1, 1));
     KeepFrontalViews(cameras_, points_, normals_, wanted, options_, &visible);
+    return Marked(visible);
+  }
+  // Which of the cameras `seen_by` marks keep the point when only the `count` most frontal do.
+  std::vector<int> MostFrontal(int count, std::vector<unsigned char> seen_by = {1, 1, 1}) const {
+    std::vector<std::vector<unsigned char>> visible;
+    for (unsigned char seen : seen_by) visible.push_back({seen});
+    KeepMostFrontalViews(cameras_, points_, normals_, count, &visible);
+    return Marked(visible);
+  }
+  static std::vector<int> Marked(const std::vector<std::vector<unsigned char>>& visible) {
     std::vector<int> kept;
     for (int c = 0; c < 3; ++c) {
       if (visible[c][0]) kept.push_back(c);
@@ -95,6 +105,14 @@ TEST_F(FrontalViewsTest, APointShortOfCamerasTakesTheMostFrontalOthers) {
   EXPECT_EQ(Kept(1), std::vector<int>({0}));
   EXPECT_EQ(Kept(2), std::vector<int>({0, 1}));
   EXPECT_EQ(Kept(3), std::vector<int>({0, 1, 2}));
+}
+
+TEST_F(FrontalViewsTest, OnlyTheMostFrontalViewsAreKeptWhateverTheirAngle) {
+  EXPECT_EQ(MostFrontal(0), std::vector<int>({}));
+  EXPECT_EQ(MostFrontal(1), std::vector<int>({0}));
+  EXPECT_EQ(MostFrontal(2), std::vector<int>({0, 1}));
+  EXPECT_EQ(MostFrontal(2, {0, 1, 1}), std::vector<int>({1, 2}));  // Only among those that see it.
+  EXPECT_EQ(MostFrontal(5), std::vector<int>({0, 1, 2}));
 }
 
 TEST_F(FrontalViewsTest, ConfidenceFollowsTheWantedCamerasAngle) {

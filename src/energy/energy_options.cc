@@ -84,7 +84,8 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
              1, 10);
     f.AddInt("shape_smoothing_rounds", &ConsensusOptions::shape_smoothing_rounds,
              "Consensus similarity: rounds of averaging over mesh neighbours of the surface a pass "
-             "found before it shapes the next pass's patches (0: as found).",
+             "found before it shapes the next pass's patches (0: as found), counted on the input "
+             "subdivided once (four times as many per further level: the same reach).",
              0, 100);
     f.AddInt("patch_rings", &ConsensusOptions::patch_rings,
              "Consensus similarity: a patch is a surface Gaussian and its neighbours up to this "

@@ -111,21 +111,36 @@ std::vector<std::pair<double, int>> ViewsOf(const std::vector<Camera>& cameras,
   return views;
 }
 
-}  // namespace
-
-void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
-                      const Eigen::Matrix3Xd& normals, int wanted, const VisibilityOptions& options,
-                      std::vector<std::vector<unsigned char>>* visible) {
-  Require(visible->size() == cameras.size(), "KeepFrontalViews", "one flag list per camera");
-  const double min_cosine = CosineOf(options.max_view_angle_deg);
+// Clears, for each point, the views past its `keep` most frontal whose cosine is below
+// `min_cosine`.
+void DropSteepViews(const char* caller, const std::vector<Camera>& cameras,
+                    const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals, int keep,
+                    double min_cosine, std::vector<std::vector<unsigned char>>* visible) {
+  Require(visible->size() == cameras.size(), caller, "one flag list per camera");
   const int n = static_cast<int>(points.cols());
 #pragma omp parallel for schedule(static)
   for (int p = 0; p < n; ++p) {
     const auto views = ViewsOf(cameras, points.col(p), normals.col(p), *visible, p);
     for (int i = 0; i < static_cast<int>(views.size()); ++i) {
-      if (views[i].first < min_cosine && i >= wanted) (*visible)[views[i].second][p] = 0;
+      if (views[i].first < min_cosine && i >= keep) (*visible)[views[i].second][p] = 0;
     }
   }
+}
+
+}  // namespace
+
+void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
+                      const Eigen::Matrix3Xd& normals, int wanted, const VisibilityOptions& options,
+                      std::vector<std::vector<unsigned char>>* visible) {
+  DropSteepViews("KeepFrontalViews", cameras, points, normals, wanted,
+                 CosineOf(options.max_view_angle_deg), visible);
+}
+
+void KeepMostFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
+                          const Eigen::Matrix3Xd& normals, int count,
+                          std::vector<std::vector<unsigned char>>* visible) {
+  // No view's cosine reaches 2: every view past the first `count` goes.
+  DropSteepViews("KeepMostFrontalViews", cameras, points, normals, count, 2.0, visible);
 }
 
 std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,

@@ -49,11 +49,21 @@ int SampleReach(const ConsensusOptions& consensus) {
   return 1 + static_cast<int>(std::ceil(2.0 * consensus.sample_blur));
 }
 
-// The energy's options with the patch's rings counted on the refined mesh (PatchRingsAt).
+// The energy's options with the patch's rings and its shape's smoothing counted on the refined
+// mesh (PatchRingsAt, SmoothingRoundsAt).
 EnergyOptions EnergyOptionsAt(const RefineOptions& options) {
   EnergyOptions energy = options.energy;
   energy.consensus.patch_rings = PatchRingsAt(options);
+  energy.consensus.shape_smoothing_rounds =
+      SmoothingRoundsAt(options, energy.consensus.shape_smoothing_rounds);
   return energy;
+}
+
+// The plane sweep's options with its costs' smoothing counted on the refined mesh.
+SweepOptions SweepOptionsAt(const RefineOptions& options) {
+  SweepOptions sweep = options.sweep;
+  sweep.smoothing_rounds = SmoothingRoundsAt(options, sweep.smoothing_rounds);
+  return sweep;
 }
 
 const RefineOptions& Checked(const RefineOptions& options) {
@@ -192,7 +202,7 @@ void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surfac
     frame->energy = std::make_unique<FrameEnergy>(surface, cameras, model.neighbourhoods(), energy);
     frame->k_max = energy.k_max;
     if (!sweep) return;
-    SweepResult start = Sweep(frame->energy.get(), options.sweep);
+    SweepResult start = Sweep(frame->energy.get(), SweepOptionsAt(options));
     const bool limited =
         options.sweep.widen_share > 0.0 && start.share_at_ends > options.sweep.widen_share &&
         widenings < options.sweep.max_widenings && energy.k_max < EnergyOptions::kLargestKMax;
@@ -283,19 +293,16 @@ namespace {
 // Per camera, which vertices of `frame.fine` the detail stage reads it for: the cameras that see
 // the surface the surface Gaussians found (`found`, smoothed as the patches' shape will be at
 // level 1, PatchAgreementTerm::EndOfPass, over the same reach at finer levels) within
-// VisibilityOptions::sample_view_angle_deg of its normals, by the geometry alone.
+// VisibilityOptions::sample_view_angle_deg of its normals, by the geometry alone, and the
+// cameras that see the input surface most frontally.
 std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& frame,
                                                          const Eigen::VectorXd& found,
                                                          const FrameInput& input,
                                                          const RefineOptions& options) {
   const FrameEnergy& energy = *frame.energy;
   Eigen::MatrixXd shape = found;
-  // The rounds count on the input subdivided once, as the patches' rings do (PatchRingsAt): an
-  // average's reach grows as the square root of its rounds, so each further level, whose edges
-  // are half as long, takes four times as many.
-  const int doublings = std::max(options.subdivision_levels - 1, 0);
-  const int rounds = options.energy.consensus.shape_smoothing_rounds << (2 * doublings);
-  energy.regularizer().AverageOverNeighbours(rounds, &shape);
+  energy.regularizer().AverageOverNeighbours(
+      SmoothingRoundsAt(options, options.energy.consensus.shape_smoothing_rounds), &shape);
   Mesh surface = frame.fine;
   const std::vector<int>& ids = energy.surface().vertex_ids;
   for (size_t s = 0; s < ids.size(); ++s) {
@@ -305,8 +312,19 @@ std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& fr
   visibility.max_view_angle_deg = visibility.sample_view_angle_deg;
   visibility.fallback_view_angle_deg =
       std::max(visibility.fallback_view_angle_deg, visibility.sample_view_angle_deg);
-  return ComputeFrameVisibility(surface, ComputeVertexNormals(surface), input.cameras, visibility,
-                                FallbackCamerasWanted(options));
+  const int wanted = FallbackCamerasWanted(options);
+  std::vector<std::vector<unsigned char>> visible = ComputeFrameVisibility(
+      surface, ComputeVertexNormals(surface), input.cameras, visibility, wanted);
+  // Where the input is far off (a visual hull) the found surface's normals, even smoothed, carry
+  // the first stage's noise and may turn a patch away from the views that see it best; the views
+  // that see the input surface most frontally are read as well (the temple: 0.654 -> 0.688
+  // held out, docs/measurements.md).
+  std::vector<std::vector<unsigned char>> frontal = frame.visible;
+  KeepMostFrontalViews(input.cameras, frame.fine.vertices, frame.normals, wanted, &frontal);
+  for (size_t c = 0; c < visible.size(); ++c) {
+    for (size_t v = 0; v < visible[c].size(); ++v) visible[c][v] |= frontal[c][v];
+  }
+  return visible;
 }
 
 }  // namespace
@@ -540,10 +558,22 @@ double ConfidentShare(const FrameResult& result) {
   return refined > 0 ? static_cast<double>(confident) / refined : std::nan("");
 }
 
+namespace {
+
+// How many times the edges of the configured level are halved from the input subdivided once.
+int HalvingsPastLevelOne(const RefineOptions& options) {
+  return std::max(options.subdivision_levels - 1, 0);
+}
+
+}  // namespace
+
 int PatchRingsAt(const RefineOptions& options) {
-  const int doublings = std::max(options.subdivision_levels - 1, 0);
-  return std::min(options.energy.consensus.patch_rings << doublings,
+  return std::min(options.energy.consensus.patch_rings << HalvingsPastLevelOne(options),
                   ConsensusOptions::kMaxPatchRings);
+}
+
+int SmoothingRoundsAt(const RefineOptions& options, int rounds) {
+  return rounds << (2 * HalvingsPastLevelOne(options));
 }
 
 double BiasCompensation(const RefineOptions& options) {
@@ -578,7 +608,9 @@ FrameResult RefineFrame(const SequenceModel& model, const ReferenceColors& color
                         SolverWorkspace* workspace) {
   return RefineFrameStartingAt(
       model, colors, input, options,
-      [&](PreparedFrame* frame) { return StartingPoint(frame, options.sweep, warm_start); },
+      [&](PreparedFrame* frame) {
+        return StartingPoint(frame, SweepOptionsAt(options), warm_start);
+      },
       /*sweeps=*/warm_start == nullptr || warm_start->size() == 0, std::move(ahead), workspace);
 }
 
@@ -592,7 +624,7 @@ FrameResult RefineFrameFrom(const SequenceModel& model, const ReferenceColors& c
   return RefineFrameStartingAt(
       model, colors, input, options,
       [&](PreparedFrame* frame) {
-        Eigen::VectorXd k = StartingPoint(frame, options.sweep, nullptr);
+        Eigen::VectorXd k = StartingPoint(frame, SweepOptionsAt(options), nullptr);
         const std::vector<int>& ids = frame->energy->surface().vertex_ids;
         for (size_t s = 0; s < ids.size(); ++s) {
           if (std::isfinite(start[ids[s]])) k[s] = start[ids[s]];

@@ -87,7 +87,9 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
                   "(0 = off, start at k = 0).",
                   kMinSamples, kMaxSamples);
     f.AddInt("smoothing_rounds", &SweepOptions::smoothing_rounds,
-             "Plane-sweep start: rounds of averaging cost curves over mesh neighbours.", 0, 1000);
+             "Plane-sweep start: rounds of averaging cost curves over mesh neighbours, counted on "
+             "the input subdivided once (four times as many per further level: the same reach).",
+             0, 1000);
     f.AddDouble("window_sigmas", &SweepOptions::window_sigmas,
                 "Plane-sweep start: each surface Gaussian first looks for its lowest cost within "
                 "this many model.sigma_hat of the input, and doubles its window only while that "

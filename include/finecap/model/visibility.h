@@ -64,6 +64,12 @@ void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd
                       const Eigen::Matrix3Xd& normals, int wanted, const VisibilityOptions& options,
                       std::vector<std::vector<unsigned char>>* visible);
 
+// Narrows `visible` to the `count` cameras that see each point most frontally (all it has when
+// fewer).
+void KeepMostFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
+                          const Eigen::Matrix3Xd& normals, int count,
+                          std::vector<std::vector<unsigned char>>* visible);
+
 // How well `wanted` cameras see each point, in [0, 1], from the cameras `visible` says see it: 1
 // when the wanted-th most frontal of them is within options.max_view_angle_deg, falling linearly
 // in the cosine of its angle to 0 at options.fallback_view_angle_deg; 0 when fewer than `wanted`

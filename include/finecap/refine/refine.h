@@ -324,6 +324,13 @@ struct FrameResult {
 // (Sceaux at level 2: held-out NCC 0.833 with one ring, 0.839 with two, 0.836 at level 1).
 int PatchRingsAt(const RefineOptions& options);
 
+// Rounds of neighbour averaging at the configured subdivision level that reach as far over the
+// surface as `rounds` rounds on the input subdivided once: an average's reach grows as the square
+// root of its rounds, so each further level, whose edges are half as long, takes four times as
+// many. The smoothings of a refinement count their rounds so (the consensus patches' shape, the
+// plane sweep's costs, the detail stage's cameras), as the patches count their rings.
+int SmoothingRoundsAt(const RefineOptions& options, int rounds);
+
 // The share of the refined vertices of `result` refined with confidence (FrameResult::confidence
 // at least 1/2), in [0, 1]; NaN when none was refined.
 double ConfidentShare(const FrameResult& result);
