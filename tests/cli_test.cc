@@ -188,6 +188,28 @@ TEST(CliTest, RefineRefusesARunForecastAboveTheMemoryLimit) {
   EXPECT_TRUE(fs::exists(out / "stats.jsonl"));
 }
 
+// A limit between the forecast and the forecast at the widest search range the plane sweep may
+// take runs, with a warning that names the range, the figures and what to lower.
+TEST(CliTest, RefineWarnsWhenTheWidestSearchRangeMightNotFit) {
+  const fs::path capture = TinyCapture("widest_range");
+  const RunResult info = RunFinecap("info --capture " + capture.string());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const long forecast = NumberAfter(info.output, "forecast per frame: peak memory ");
+  const long widest = NumberAfter(info.output, "(up to ");
+  ASSERT_GT(widest, forecast + 2) << info.output;
+  const std::string limit = std::to_string((forecast + widest) / 2);
+  const RunResult refine = RunFinecap(
+      "refine --capture " + capture.string() + " --out " + (capture / ".." / "out").string() +
+      " --set solver.max_iterations=1,runtime.max_memory_mb=" + limit);
+  EXPECT_EQ(refine.exit_code, 0) << refine.output;
+  for (const std::string& part :
+       {std::string("warning: a frame whose plane sweep widens its search range to "),
+        "would need about " + std::to_string(widest) + " MB, more than the " + limit + " MB",
+        std::string("refine.sweep.max_widenings")}) {
+    EXPECT_NE(refine.output.find(part), std::string::npos) << part << "\n" << refine.output;
+  }
+}
+
 // Refine's summary states the share of vertices refined with confidence, and says so when a
 // capture cannot be refined usefully: three cameras 120 degrees apart never give a point a third
 // camera within the fallback view angle, so asking for three leaves no vertex with confidence. The

@@ -89,6 +89,28 @@ TEST_F(ProblemSizeTest, MoreReachMeansMorePairsAndMoreMemory) {
   EXPECT_GT(wide.seconds_per_frame, size.seconds_per_frame);
 }
 
+// The plane sweep may double k_max up to max_widenings times: the widest range is forecast as a
+// run configured with it from the start would be, and equals the configured one where the sweep
+// does not widen.
+TEST_F(ProblemSizeTest, TheWidestRangeTheSweepMayTakeIsForecast) {
+  PreparedFrame prepared;
+  const ProblemSize size = Estimate(options_, &prepared);
+  const double widest = std::min(options_.energy.k_max * (1 << options_.sweep.max_widenings),
+                                 EnergyOptions::kLargestKMax);
+  ASSERT_GT(widest, options_.energy.k_max);
+  EXPECT_DOUBLE_EQ(size.widest_k_max, widest);
+  EXPECT_GT(size.widest_peak_memory_mb, size.peak_memory_mb);
+
+  RefineOptions configured_widest = options_;
+  configured_widest.energy.k_max = widest;
+  configured_widest.sweep.widen_share = 0.0;
+  const ProblemSize as_configured = Estimate(configured_widest, &prepared);
+  EXPECT_NEAR(size.widest_peak_memory_mb, as_configured.peak_memory_mb,
+              1e-9 * as_configured.peak_memory_mb);
+  EXPECT_DOUBLE_EQ(as_configured.widest_k_max, widest);
+  EXPECT_DOUBLE_EQ(as_configured.widest_peak_memory_mb, as_configured.peak_memory_mb);
+}
+
 TEST_F(ProblemSizeTest, VerticesNoCameraSeesAreCounted) {
   RefineOptions narrow = options_;
   narrow.visibility.max_view_angle_deg = 1.0;
@@ -126,6 +148,13 @@ TEST_F(ProblemSizeTest, UndistortedImagesTakeMoreMemory) {
 
 // A forecast above the run's own limit or above what the system has is refused with the figure,
 // the limit and what to lower; one within both is not.
+TEST(MemoryLimitTest, TheRunsOwnLimitWhenBelowWhatIsAvailable) {
+  const AvailableMemory available{4000.0, "/proc/meminfo"};
+  EXPECT_EQ(MemoryLimitMb(0, available), 4000.0);
+  EXPECT_EQ(MemoryLimitMb(1000, available), 1000.0);
+  EXPECT_EQ(MemoryLimitMb(9000, available), 4000.0);
+}
+
 TEST(RequireMemoryForTest, RefusesAForecastAboveEitherLimit) {
   ProblemSize size;
   size.peak_memory_mb = 812.4;

@@ -88,6 +88,20 @@ std::string RoundedCount(double count) {
   return text.str();
 }
 
+std::string Millimetres(double metres) {
+  std::ostringstream text;
+  text.precision(metres < 0.01 ? 1 : 0);
+  text << std::fixed << metres * 1e3 << " mm";
+  return text.str();
+}
+
+std::string WidestRangeForecast(const ProblemSize& size) {
+  if (!(size.widest_peak_memory_mb > size.peak_memory_mb)) return "";
+  return " (up to " + std::to_string(std::lround(size.widest_peak_memory_mb)) +
+         " MB if a frame's plane sweep widens its search range to " +
+         Millimetres(size.widest_k_max) + ")";
+}
+
 std::string RoundedSeconds(double seconds) {
   std::ostringstream text;
   text.precision(seconds < 10.0 || (seconds >= 60.0 && seconds < 600.0) ? 1 : 0);
@@ -168,8 +182,16 @@ class ConsoleObserver : public SequenceObserver {
               << " cameras of " << camera.width << "x" << camera.height << ", "
               << size.num_surface_gaussians << " surface Gaussians (of " << size.num_fine_vertices
               << " vertices after subdivision), about " << RoundedCount(size.num_pairs)
-              << " pairs; expected peak memory " << std::lround(size.peak_memory_mb)
-              << " MB, about " << RoundedSeconds(size.seconds_per_frame) << " per frame\n";
+              << " pairs; expected peak memory " << std::lround(size.peak_memory_mb) << " MB"
+              << WidestRangeForecast(size) << ", about " << RoundedSeconds(size.seconds_per_frame)
+              << " per frame\n";
+  }
+  void WidestRangeMayNotFit(const ProblemSize& size, double limit_mb) override {
+    std::cerr << "finecap " << command_ << ": warning: a frame whose plane sweep widens its "
+              << "search range to " << Millimetres(size.widest_k_max) << " would need about "
+              << std::lround(size.widest_peak_memory_mb) << " MB, more than the "
+              << std::lround(limit_mb) << " MB the run may take; lower "
+              << "refine.sweep.max_widenings to keep every frame within it\n";
   }
   void CameraSkipped(const std::string& frame, const SkippedCamera& camera) override {
     WarnSkipped(frame, camera);

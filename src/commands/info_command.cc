@@ -109,8 +109,9 @@ int RunInfo(const Config& configured) {
   std::cout << "problem per frame: " << size.num_image_gaussians << " image Gaussians, about "
             << internal::RoundedCount(size.num_pairs) << " pairs of Gaussians, "
             << size.num_observations << " observations\n";
-  std::cout << "forecast per frame: peak memory " << std::lround(size.peak_memory_mb)
-            << " MB, about " << internal::RoundedSeconds(size.seconds_per_frame) << " ("
+  std::cout << "forecast per frame: peak memory " << std::lround(size.peak_memory_mb) << " MB"
+            << internal::WidestRangeForecast(size) << ", about "
+            << internal::RoundedSeconds(size.seconds_per_frame) << " ("
             << internal::RoundedSeconds(size.seconds_per_frame * frames.size()) << " for "
             << frames.size() << " frames)\n";
   PrintWarnings(config, input.cameras, size);

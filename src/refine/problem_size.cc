@@ -108,6 +108,56 @@ int SamplesPerRegularPatch(int rings, int levels) {
   return 1 + 3 * (radius - 1) * radius;
 }
 
+// The pairs that `energy`'s similarity, searching within `k_max`, makes of `surface` and the
+// cameras' image Gaussians `images`, where `visible` says a camera sees a vertex: a sample of at
+// most kSampledSurfaceGaussians per camera, scaled.
+double CountPairs(const std::vector<Camera>& cameras, const std::vector<ImageGaussians>& images,
+                  const SurfaceGaussians& surface,
+                  const std::vector<std::vector<unsigned char>>& visible,
+                  const EnergyOptions& energy, double k_max) {
+  PairOptions pair_options = EnergyPairOptions(energy);
+  pair_options.k_max = k_max;
+  double pairs = 0.0;
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    std::vector<unsigned char> seen;
+    for (int v : surface.vertex_ids) seen.push_back(visible[c][v]);
+    const long observations = std::count(seen.begin(), seen.end(), 1);
+    const int stride = static_cast<int>(std::max<long>(
+        1, (observations + kSampledSurfaceGaussians - 1) / kSampledSurfaceGaussians));
+    pairs += CountCameraPairs(cameras[c], images[c], surface, seen, pair_options, stride);
+  }
+  return pairs;
+}
+
+// The bytes of a frame held that grow with its search range `k_max`: its `num_pairs` while they
+// are built and, for the consensus similarity, its colour tables over the range.
+double RangeBytesPerFrame(double num_pairs, long num_observations, EnergyOptions energy,
+                          double k_max, double sigma_hat) {
+  const SimilarityNeeds needs = NeedsOf(energy);
+  double bytes = num_pairs * (needs.reads_surface_samples ? kBytesPerConsensusPairWithSamples
+                              : needs.compares_patches    ? kBytesPerConsensusPair
+                                                          : kBytesPerPair);
+  energy.k_max = k_max;
+  if (const int nodes = ColorTableNodes(energy, sigma_hat); nodes > 0) {
+    // Its colour tables: value and derivative, 3 floats each, per node.
+    bytes += num_observations * (nodes * 24.0 + kTabledBytesPerObservation);
+  }
+  return bytes;
+}
+
+// The widest search range a frame may take: the plane sweep doubles k_max while the range
+// limits it (SweepOptions::widen_share), at most max_widenings times and to
+// EnergyOptions::kLargestKMax.
+double WidestRange(const RefineOptions& options) {
+  double k_max = options.energy.k_max;
+  const SweepOptions& sweep = options.sweep;
+  if (sweep.samples == 0 || sweep.widen_share <= 0.0) return k_max;
+  for (int widening = 0; widening < sweep.max_widenings; ++widening) {
+    k_max = std::max(k_max, std::min(2.0 * k_max, EnergyOptions::kLargestKMax));
+  }
+  return k_max;
+}
+
 }  // namespace
 
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
@@ -134,29 +184,19 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   const SurfaceGaussians surface =
       MakeSurfaceGaussians(fine.vertices, normals, model.refined_vertices(), colors);
   size.num_surface_gaussians = surface.size();
-  const PairOptions pair_options = EnergyPairOptions(options.energy);
   for (size_t c = 0; c < frame.cameras.size(); ++c) {
-    std::vector<unsigned char> seen;
-    for (int v : surface.vertex_ids) seen.push_back(visible[c][v]);
-    const long observations = std::count(seen.begin(), seen.end(), 1);
-    const int stride = static_cast<int>(std::max<long>(
-        1, (observations + kSampledSurfaceGaussians - 1) / kSampledSurfaceGaussians));
-    size.num_pairs +=
-        CountCameraPairs(frame.cameras[c], images[c], surface, seen, pair_options, stride);
-    size.num_observations += observations;
+    size.num_observations += std::count_if(surface.vertex_ids.begin(), surface.vertex_ids.end(),
+                                           [&](int v) { return visible[c][v] != 0; });
     size.num_image_gaussians += images[c].size();
     size.num_pixels += double(frame.cameras[c].width) * frame.cameras[c].height;
   }
-
-  const SimilarityNeeds needs = NeedsOf(options.energy);
-  const bool patches = needs.compares_patches, sampled = needs.reads_surface_samples;
-  double per_frame = size.num_pairs * (sampled   ? kBytesPerConsensusPairWithSamples
-                                       : patches ? kBytesPerConsensusPair
-                                                 : kBytesPerPair);
-  if (const int nodes = ColorTableNodes(options.energy, options.sigma_hat); nodes > 0) {
-    // Its colour tables: value and derivative, 3 floats each, per node.
-    per_frame += size.num_observations * (nodes * 24.0 + kTabledBytesPerObservation);
-  }
+  const auto pairs_within = [&](double k_max) {
+    return CountPairs(frame.cameras, images, surface, visible, options.energy, k_max);
+  };
+  size.num_pairs = pairs_within(options.energy.k_max);
+  const double per_frame = RangeBytesPerFrame(size.num_pairs, size.num_observations, options.energy,
+                                              options.energy.k_max, options.sigma_hat);
+  const bool sampled = NeedsOf(options.energy).reads_surface_samples;
   double detail_bytes = 0.0, detail_seconds = 0.0;
   if (sampled) {
     const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
@@ -176,6 +216,17 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
           ((sampled ? kBytesPerSurfaceGaussianWithSamples : kBytesPerSurfaceGaussian) +
            (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
+  size.widest_k_max = WidestRange(options);
+  size.widest_peak_memory_mb = size.peak_memory_mb;
+  if (size.widest_k_max > options.energy.k_max) {
+    const double widest_pairs = pairs_within(size.widest_k_max);
+    size.widest_peak_memory_mb +=
+        frames_held *
+        (RangeBytesPerFrame(widest_pairs, size.num_observations, options.energy, size.widest_k_max,
+                            options.sigma_hat) -
+         per_frame) /
+        1e6;
+  }
   size.seconds_per_frame = sampled ? size.num_pairs * kSecondsPerPairWithSamples + detail_seconds
                                    : size.num_pairs * kSecondsPerPair +
                                          size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
@@ -201,9 +252,9 @@ void AddHeldOutScoring(const std::vector<CalibratedImage>& held_out, int num_tra
 
 void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,
                       int max_memory_mb, const AvailableMemory& available) {
-  const bool own_limit = max_memory_mb > 0 && max_memory_mb < available.megabytes;
-  const double limit = own_limit ? max_memory_mb : available.megabytes;
+  const double limit = MemoryLimitMb(max_memory_mb, available);
   if (!(size.peak_memory_mb > limit)) return;
+  const bool own_limit = limit < available.megabytes;
   std::ostringstream problem;
   problem.precision(2);
   problem << std::fixed << "the forecast peak memory of this run, "
@@ -219,6 +270,11 @@ void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptio
   }
   problem << (own_limit ? ", or raise SequenceOptions::max_memory_mb" : ", or free memory for it");
   throw Error(own_limit ? "SequenceOptions::max_memory_mb" : available.source, problem.str());
+}
+
+double MemoryLimitMb(int max_memory_mb, const AvailableMemory& available) {
+  const bool own_limit = max_memory_mb > 0 && max_memory_mb < available.megabytes;
+  return own_limit ? max_memory_mb : available.megabytes;
 }
 
 double UndistortedPixels(const Capture& capture) {

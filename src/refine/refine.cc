@@ -199,6 +199,7 @@ void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surfac
                       bool sweep, PreparedFrame* frame) {
   EnergyOptions energy = EnergyOptionsAt(options);
   for (int widenings = 0;; ++widenings) {
+    frame->energy.reset();  // A narrower range's energy is not needed while a wider one is built.
     frame->energy = std::make_unique<FrameEnergy>(surface, cameras, model.neighbourhoods(), energy);
     frame->k_max = energy.k_max;
     if (!sweep) return;

@@ -270,9 +270,11 @@ class SequenceRun {
                                            frames.size(), UndistortedPixels(*capture_));
     AddHeldOutScoring(first.held_out, static_cast<int>(first.input.cameras.size()),
                       options_.held_out_score.neighbours, &size);
-    RequireMemoryFor(size, frames.size(), options_.refine, options_.max_memory_mb,
-                     ReadAvailableMemory());
+    const AvailableMemory available = ReadAvailableMemory();
+    RequireMemoryFor(size, frames.size(), options_.refine, options_.max_memory_mb, available);
     observer_->Starting(frames.size(), first.input, size);
+    const double limit = MemoryLimitMb(options_.max_memory_mb, available);
+    if (size.widest_peak_memory_mb > limit) observer_->WidestRangeMayNotFit(size, limit);
     reader_.Keep(frames.begin, std::move(first));
   }
 

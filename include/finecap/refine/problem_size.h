@@ -48,6 +48,14 @@ struct ProblemSize {
 
   // Forecast peak resident memory of a run refining frames like this one, MB.
   double peak_memory_mb = 0.0;
+  // The same were every frame to widen its search range as far as the plane sweep may
+  // (SweepOptions::widen_share: k_max doubled up to max_widenings times, to
+  // EnergyOptions::kLargestKMax at most): that range, metres, and the forecast peak with it (the
+  // pairs and the colour tables grow with the range). Equal to k_max and peak_memory_mb when the
+  // sweep does not widen. Whether a frame widens is known only once its sweep has run, so a run
+  // is refused on peak_memory_mb alone, and told when the widest range might not fit.
+  double widest_k_max = 0.0;
+  double widest_peak_memory_mb = 0.0;
   // Forecast time of one frame, seconds, on the machine the constants were measured on (2 idle
   // cores), the held-out score included once AddHeldOutScoring has added it: a rough figure,
   // within 0.5 to 2 times the wall time on the captures that bench/memory_forecast.sh covers.
@@ -82,6 +90,10 @@ double UndistortedPixels(const Capture& capture);
 // forecast just above the limit may have fitted, and one just below may not.
 void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptions& options,
                       int max_memory_mb, const AvailableMemory& available);
+
+// The memory a run may take, MB: `max_memory_mb` when it is set (above 0) and below what is
+// `available`, else what is available.
+double MemoryLimitMb(int max_memory_mb, const AvailableMemory& available);
 
 }  // namespace finecap
 

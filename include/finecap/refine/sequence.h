@@ -164,6 +164,9 @@ class SequenceObserver {
   // refinement sees it and the size of its problem.
   virtual void Starting(int /*num_frames*/, const FrameInput& /*first*/,
                         const ProblemSize& /*size*/) {}
+  // Right after Starting: a frame whose sweep widened its search range to the widest it may
+  // (ProblemSize::widest_k_max) would need more memory than the run may take, `limit_mb`.
+  virtual void WidestRangeMayNotFit(const ProblemSize& /*size*/, double /*limit_mb*/) {}
   // A camera's image of `frame` could not be read and the frame goes on without it
   // (skip_unreadable_cameras).
   virtual void CameraSkipped(const std::string& /*frame*/, const SkippedCamera& /*camera*/) {}
