@@ -145,19 +145,6 @@ double RangeBytesPerFrame(double num_pairs, long num_observations, EnergyOptions
   return bytes;
 }
 
-// The widest search range a frame may take: the plane sweep doubles k_max while the range
-// limits it (SweepOptions::widen_share), at most max_widenings times and to
-// EnergyOptions::kLargestKMax.
-double WidestRange(const RefineOptions& options) {
-  double k_max = options.energy.k_max;
-  const SweepOptions& sweep = options.sweep;
-  if (sweep.samples == 0 || sweep.widen_share <= 0.0) return k_max;
-  for (int widening = 0; widening < sweep.max_widenings; ++widening) {
-    k_max = std::max(k_max, std::min(2.0 * k_max, EnergyOptions::kLargestKMax));
-  }
-  return k_max;
-}
-
 }  // namespace
 
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
@@ -216,7 +203,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
           ((sampled ? kBytesPerSurfaceGaussianWithSamples : kBytesPerSurfaceGaussian) +
            (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
   size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
-  size.widest_k_max = WidestRange(options);
+  size.widest_k_max = WidestSearchRange(options);
   size.widest_peak_memory_mb = size.peak_memory_mb;
   if (size.widest_k_max > options.energy.k_max) {
     const double widest_pairs = pairs_within(size.widest_k_max);

@@ -191,6 +191,9 @@ std::vector<double> InputOffsets(const SequenceModel& model, const Mesh& coarse,
   return offsets;
 }
 
+// The search range a frame widens to from `k_max` (BuildSweptEnergy, WidestSearchRange).
+double WidenedRange(double k_max) { return std::min(2.0 * k_max, EnergyOptions::kLargestKMax); }
+
 // Builds the energy of `surface` over `cameras` and, when `sweep`, finds the plane sweep's start
 // (frame->sweep_start), doubling the frame's range and building the energy again while the sweep
 // says that the range limits it (SweepOptions::widen_share). frame->k_max is the range used.
@@ -211,7 +214,7 @@ void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surfac
       frame->sweep_start = std::move(start.k);
       return;
     }
-    energy.k_max = std::min(2.0 * energy.k_max, EnergyOptions::kLargestKMax);
+    energy.k_max = WidenedRange(energy.k_max);
   }
 }
 
@@ -575,6 +578,17 @@ int PatchRingsAt(const RefineOptions& options) {
 
 int SmoothingRoundsAt(const RefineOptions& options, int rounds) {
   return rounds << (2 * HalvingsPastLevelOne(options));
+}
+
+double WidestSearchRange(const RefineOptions& options) {
+  double k_max = options.energy.k_max;
+  const SweepOptions& sweep = options.sweep;
+  if (sweep.samples == 0 || sweep.widen_share <= 0.0) return k_max;
+  for (int widening = 0; widening < sweep.max_widenings && k_max < EnergyOptions::kLargestKMax;
+       ++widening) {
+    k_max = WidenedRange(k_max);
+  }
+  return k_max;
 }
 
 double BiasCompensation(const RefineOptions& options) {

@@ -331,6 +331,11 @@ int PatchRingsAt(const RefineOptions& options);
 // plane sweep's costs, the detail stage's cameras), as the patches count their rings.
 int SmoothingRoundsAt(const RefineOptions& options, int rounds);
 
+// The widest search range a frame may take, metres: the plane sweep doubles energy.k_max while
+// the range limits it (SweepOptions::widen_share), at most SweepOptions::max_widenings times and
+// to EnergyOptions::kLargestKMax; energy.k_max where the sweep does not widen.
+double WidestSearchRange(const RefineOptions& options);
+
 // The share of the refined vertices of `result` refined with confidence (FrameResult::confidence
 // at least 1/2), in [0, 1]; NaN when none was refined.
 double ConfidentShare(const FrameResult& result);
