@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Whether the search range (energy.k_max) limits a result: every capture refined with its automatic
-# range R (the scene's, widened per frame where the plane sweep finds it limiting) and with R / 2
-# and 2 R set explicitly, each as a starting range (`--set energy.k_max=...`). The real captures
+# range R (the scene's, widened per frame where the plane sweep finds it limiting and narrowed
+# where the sweep finds it far wider than the frame needs) and with R / 2 and 2 R set explicitly,
+# each as a starting range (`--set energy.k_max=...`). The real captures
 # are scored by their held-out NCC (heldout_ncc_refined), the synthetic ones by their RMS against
 # the truth (frames 0-2 pooled) and the share of the detail recovered.
 #
@@ -66,12 +67,12 @@ for capture in $captures; do
   [ -n "$(capture_args "$capture")" ] || { echo "$capture: SKIPPED (no capture)" >&2; continue; }
   read -r auto started widest < <(refine "$capture" auto "")
   name=$([ "$capture" = temple ] || [ "$capture" = sceaux ] && echo heldout_ncc || echo rms_mm)
-  echo "$capture R ($started mm, widened to $widest mm) $name: $auto"
+  echo "$capture R ($started mm, widest solved in $widest mm) $name: $auto"
   metres=$(awk -v mm="$started" 'BEGIN { printf "%.6g", mm / 1000 }')
   for factor in 0.5 2; do
     k=$(awk -v m="$metres" -v f="$factor" 'BEGIN { printf "%.6g", m * f }')
     read -r figure started widest < <(refine "$capture" "x$factor" "$k")
     change=$(awk -v a="$figure" -v b="$auto" 'BEGIN { printf "%+.2f", 100 * (a - b) / b }')
-    echo "$capture ${factor}R ($started mm, widened to $widest mm) $name: $figure ($change %)"
+    echo "$capture ${factor}R ($started mm, widest solved in $widest mm) $name: $figure ($change %)"
   done
 done

@@ -12,7 +12,8 @@
 # no procedural folds). Without it, the built-in skirt with its procedural folds
 # (configs/synth_skirt_smoothed.yaml).
 # Environment: FRAMES (default 10), ITERATIONS (synth.smoothing.iterations, default the
-# preset's), KEEP=1 to keep the capture and the run (printed), FINECAP (default build/finecap).
+# preset's), KEEP=1 to keep the capture and the run (printed), FINECAP (default build/finecap),
+# SET (extra settings of the refinement, --set).
 #
 # Prints a line per frame, "frame <name>: input_rms_mm A subdivided_rms_mm S refined_rms_mm B
 # recovered_percent C" (RMS distance to the truth over every refined vertex of the coarse mesh as
@@ -48,7 +49,8 @@ start=$(date +%s.%N)
   --set "$overrides" >/dev/null
 synth_seconds=$(seconds_since "$start")
 start=$(date +%s.%N)
-"$finecap" refine --capture "$work/capture" --out "$work/run" >/dev/null 2>"$work/refine.log"
+"$finecap" refine --capture "$work/capture" --out "$work/run" --set "${SET:-}" >/dev/null \
+  2>"$work/refine.log"
 refine_seconds=$(seconds_since "$start")
 # Only the figures against the truth are printed: the optical flow is left out to save time.
 start=$(date +%s.%N)

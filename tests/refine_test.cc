@@ -126,6 +126,35 @@ TEST_F(RefineFrameTest, TheDetailStageReadsTheCamerasWithinItsOwnAngle) {
   EXPECT_THROW(PrepareDetailEnergy(model, input, defaults, too_short, &frame), Error);
 }
 
+// The plane sweep sets the range a frame is solved in from what it finds: a range far narrower
+// than the input's error limits many Gaussians and widens, one far wider than it holds almost
+// every Gaussian's best displacement in its inner half and narrows, never below sigma_hat. With
+// both rules off the frame keeps the range it was given.
+TEST_F(RefineFrameTest, TheSweepWidensANarrowRangeAndNarrowsAWideOne) {
+  Capture capture = Capture::Open(*directory_);
+  RefineOptions options;
+  options.solver.max_iterations = 1;
+  options.energy.consensus.sample_spacing = 0.0;
+  const FrameInput input = ReadFrameInput(&capture, 0);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, input, options);
+  const auto range_solved_in = [&](double k_max, double widen_share, double narrow_share) {
+    RefineOptions ranged = options;
+    ranged.energy.k_max = k_max;
+    ranged.sweep.widen_share = widen_share;
+    ranged.sweep.narrow_share = narrow_share;
+    return RefineFrame(model, colors, input, ranged).k_max;
+  };
+  const double narrow = 0.05 * options.sigma_hat, wide = 64.0 * options.sigma_hat;
+  const SweepOptions defaults;
+  EXPECT_GT(range_solved_in(narrow, defaults.widen_share, defaults.narrow_share), narrow);
+  const double narrowed = range_solved_in(wide, defaults.widen_share, defaults.narrow_share);
+  EXPECT_LT(narrowed, wide);
+  EXPECT_GE(narrowed, options.sigma_hat);
+  EXPECT_EQ(range_solved_in(narrow, 0.0, 0.0), narrow);
+  EXPECT_EQ(range_solved_in(wide, 0.0, 0.0), wide);
+}
+
 // A frame modelled ahead (ModelFrameImages) gives its own models to every stage that asks with the
 // same options, keeps those of the cameras left after the held-out ones are set aside, and is
 // modelled afresh under other options; the frame it solves to is the one it solves to unmodelled.

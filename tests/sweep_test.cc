@@ -24,9 +24,11 @@ TEST(SweepTest, GaussiansNoBlockReachesStartOnTheCoarseMesh) {
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
                      SweepEnergyOptions(SimilarityType::kConsensus));
   ASSERT_TRUE(energy.data_term(0).residual_blocks().empty());
-  const Eigen::VectorXd k = SweepInitialization(&energy, SweepOptions());
-  ASSERT_EQ(k.size(), energy.num_parameters());
-  EXPECT_TRUE(k.isZero(0.0)) << k.transpose();
+  const SweepResult result = Sweep(&energy, SweepOptions());
+  ASSERT_EQ(result.k.size(), energy.num_parameters());
+  EXPECT_TRUE(result.k.isZero(0.0)) << result.k.transpose();
+  // No curve is counted, and nothing says that the range is too wide.
+  EXPECT_EQ(result.share_in_outer_half, 1.0);
 }
 
 // With cameras to compare, each start is a sampled displacement moved by at most half a sample
@@ -94,13 +96,14 @@ TEST(WindowedMinimumTest, ACostFallingToTheRangesEndStopsThere) {
 
 // The share of Gaussians the range limits counts those whose start is at an end of the range:
 // with the range so narrow that the costs cannot turn (one sample each side of 0 and the input
-// off by more), some are; with a wide range fewer.
+// off by more), some are; with a wide range fewer. So are those whose start lies in the outer half
+// of the range, which say whether a range is wider than its Gaussians need.
 TEST(SweepTest, ANarrowRangeLimitsMoreGaussians) {
   const EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
   SweepOptions sweep;
   sweep.samples = 9;
   sweep.max_step_sigmas = 0.0;
-  double share[2];
+  double share[2], outer_half[2];
   for (int wide = 0; wide < 2; ++wide) {
     EnergyOptions options = SweepEnergyOptions(SimilarityType::kConsensus);
     options.k_max = wide ? 0.01 : 1e-4;
@@ -109,9 +112,12 @@ TEST(SweepTest, ANarrowRangeLimitsMoreGaussians) {
     int at_ends = 0;
     for (int s = 0; s < result.k.size(); ++s) at_ends += std::abs(result.k[s]) == options.k_max;
     EXPECT_DOUBLE_EQ(result.share_at_ends, static_cast<double>(at_ends) / result.k.size());
+    EXPECT_GE(result.share_in_outer_half, result.share_at_ends);
     share[wide] = result.share_at_ends;
+    outer_half[wide] = result.share_in_outer_half;
   }
   EXPECT_GT(share[0], share[1]);
+  EXPECT_GT(outer_half[0], outer_half[1]);
 }
 
 TEST(SweepTest, SweepOffStartsEveryGaussianAtZero) {

@@ -194,27 +194,42 @@ std::vector<double> InputOffsets(const SequenceModel& model, const Mesh& coarse,
 // The search range a frame widens to from `k_max` (BuildSweptEnergy, WidestSearchRange).
 double WidenedRange(double k_max) { return std::min(2.0 * k_max, EnergyOptions::kLargestKMax); }
 
+// The range a frame's sweep `start` over `k_max` asks for next (SweepOptions::widen_share,
+// narrow_share), or k_max itself when the range stands. A range widens at most
+// sweep.max_widenings times, and one that widened never narrows (nor the other way round), so
+// that the search ends. `changes`: the range's changes so far, positive when it widened.
+double NextRange(const SweepResult& start, double k_max, double sigma_hat, int changes,
+                 const SweepOptions& sweep) {
+  const bool limited = sweep.widen_share > 0.0 && start.share_at_ends > sweep.widen_share &&
+                       changes >= 0 && changes < sweep.max_widenings &&
+                       k_max < EnergyOptions::kLargestKMax;
+  if (limited) return WidenedRange(k_max);
+  const bool too_wide = sweep.narrow_share > 0.0 && changes <= 0 &&
+                        start.share_in_outer_half < sweep.narrow_share && 0.5 * k_max >= sigma_hat;
+  return too_wide ? 0.5 * k_max : k_max;
+}
+
 // Builds the energy of `surface` over `cameras` and, when `sweep`, finds the plane sweep's start
-// (frame->sweep_start), doubling the frame's range and building the energy again while the sweep
-// says that the range limits it (SweepOptions::widen_share). frame->k_max is the range used.
+// (frame->sweep_start), building the energy again over a wider or a narrower range while the
+// sweep says that the range limits it or is far wider than its Gaussians need (NextRange).
+// frame->k_max is the range used.
 void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surface,
                       const std::vector<CameraInput>& cameras, const RefineOptions& options,
                       bool sweep, PreparedFrame* frame) {
   EnergyOptions energy = EnergyOptionsAt(options);
-  for (int widenings = 0;; ++widenings) {
-    frame->energy.reset();  // A narrower range's energy is not needed while a wider one is built.
+  for (int changes = 0;;) {
+    frame->energy.reset();  // The last range's energy is not needed while the next is built.
     frame->energy = std::make_unique<FrameEnergy>(surface, cameras, model.neighbourhoods(), energy);
     frame->k_max = energy.k_max;
     if (!sweep) return;
     SweepResult start = Sweep(frame->energy.get(), SweepOptionsAt(options));
-    const bool limited =
-        options.sweep.widen_share > 0.0 && start.share_at_ends > options.sweep.widen_share &&
-        widenings < options.sweep.max_widenings && energy.k_max < EnergyOptions::kLargestKMax;
-    if (!limited) {
+    const double next = NextRange(start, energy.k_max, surface.sigma_hat, changes, options.sweep);
+    if (next == energy.k_max) {
       frame->sweep_start = std::move(start.k);
       return;
     }
-    energy.k_max = WidenedRange(energy.k_max);
+    changes += next > energy.k_max ? 1 : -1;
+    energy.k_max = next;
   }
 }
 

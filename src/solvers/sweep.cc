@@ -89,7 +89,7 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];
   const int last = static_cast<int>(displacements.size()) - 1;
-  int at_ends = 0;
+  int at_ends = 0, counted = 0, in_outer_half = 0;
   for (int s = 0; s < n; ++s) {
     // A Gaussian whose curve is flat (no block reaches it, nor its neighbours' costs) has no
     // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
@@ -105,8 +105,11 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
       const double curvature = c0 - 2.0 * c1 + c2;
       if (curvature > 0.0) result.k[s] += 0.5 * step * (c0 - c2) / curvature;
     }
+    counted += confident;
+    in_outer_half += confident && std::abs(result.k[s]) > 0.5 * k_max;
   }
   result.share_at_ends = static_cast<double>(at_ends) / n;
+  result.share_in_outer_half = counted > 0 ? static_cast<double>(in_outer_half) / counted : 1.0;
   return result;
 }
 
