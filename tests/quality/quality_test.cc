@@ -189,17 +189,20 @@ TEST(QualityTest, SmoothedInputEndsBelowItsInputInEveryFrame) {
 }
 
 // synth_skirt_exact (configs/synth_skirt_exact.yaml): the coarse vertices lie on the truth, the
-// honest best case of an input. No frame may end worse than its input as given; today the worst
-// frame gains 38.2 % (38.4 % pooled, 1.279 -> 0.788 mm).
+// honest best case of an input. No frame may end worse than its input as given; today (measured
+// 2026-12-05) the worst frame gains 47.2 % (47.7 % pooled, 1.279 -> 0.669 mm).
 TEST(QualityTest, ExactInputEndsNoWorseInAnyFrame) {
   const std::vector<YAML::Node> records = SynthAndRefine("exact", "synth_skirt_exact.yaml");
   ASSERT_EQ(records.size(), 3u);
+  // Margin 2.5 points, tighter than elsewhere: this input leaves the least to gain, so a loss
+  // shows first here, and its search range shows here alone. Solved in the automatic 24 mm
+  // instead of the 6 mm the plane sweep narrows it to (refine.sweep.narrow_share), it gains
+  // 43.8 % (worst frame 43.3 %).
   for (const YAML::Node& record : records) {
     SCOPED_TRACE(record["frame"].as<std::string>());
-    // Margin 8 points: this input leaves the least to gain, so a loss shows first here.
-    EXPECT_GT(Gain(record), 0.30);
+    EXPECT_GT(Gain(record), 0.45);
   }
-  EXPECT_GT(PooledGain(records), 0.30);
+  EXPECT_GT(PooledGain(records), 0.45);
 }
 
 // A real capture refined with views held out (the capture's own `validation.cameras`), as
