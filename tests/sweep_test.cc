@@ -1,6 +1,7 @@
 #include "finecap/solvers/sweep.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -28,7 +29,7 @@ TEST(SweepTest, GaussiansNoBlockReachesStartOnTheCoarseMesh) {
   ASSERT_EQ(result.k.size(), energy.num_parameters());
   EXPECT_TRUE(result.k.isZero(0.0)) << result.k.transpose();
   // No curve is counted, and nothing says that the range is too wide.
-  EXPECT_EQ(result.share_in_outer_half, 1.0);
+  EXPECT_EQ(result.reach, std::numeric_limits<double>::infinity());
 }
 
 // With cameras to compare, each start is a sampled displacement moved by at most half a sample
@@ -96,14 +97,14 @@ TEST(WindowedMinimumTest, ACostFallingToTheRangesEndStopsThere) {
 
 // The share of Gaussians the range limits counts those whose start is at an end of the range:
 // with the range so narrow that the costs cannot turn (one sample each side of 0 and the input
-// off by more), some are; with a wide range fewer. So are those whose start lies in the outer half
-// of the range, which say whether a range is wider than its Gaussians need.
+// off by more), some are; with a wide range fewer. The sweep's reach, which says whether a range
+// is wider than its Gaussians need, lies within the range, and all of it with no share left out.
 TEST(SweepTest, ANarrowRangeLimitsMoreGaussians) {
   const EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
   SweepOptions sweep;
   sweep.samples = 9;
   sweep.max_step_sigmas = 0.0;
-  double share[2], outer_half[2];
+  double share[2];
   for (int wide = 0; wide < 2; ++wide) {
     EnergyOptions options = SweepEnergyOptions(SimilarityType::kConsensus);
     options.k_max = wide ? 0.01 : 1e-4;
@@ -112,12 +113,13 @@ TEST(SweepTest, ANarrowRangeLimitsMoreGaussians) {
     int at_ends = 0;
     for (int s = 0; s < result.k.size(); ++s) at_ends += std::abs(result.k[s]) == options.k_max;
     EXPECT_DOUBLE_EQ(result.share_at_ends, static_cast<double>(at_ends) / result.k.size());
-    EXPECT_GE(result.share_in_outer_half, result.share_at_ends);
     share[wide] = result.share_at_ends;
-    outer_half[wide] = result.share_in_outer_half;
+    EXPECT_LE(result.reach, options.k_max);
+    sweep.narrow_share = 0.0;
+    EXPECT_DOUBLE_EQ(Sweep(&energy, sweep).reach, result.k.cwiseAbs().maxCoeff());
+    sweep.narrow_share = SweepOptions().narrow_share;
   }
   EXPECT_GT(share[0], share[1]);
-  EXPECT_GT(outer_half[0], outer_half[1]);
 }
 
 TEST(SweepTest, SweepOffStartsEveryGaussianAtZero) {

@@ -195,18 +195,21 @@ std::vector<double> InputOffsets(const SequenceModel& model, const Mesh& coarse,
 double WidenedRange(double k_max) { return std::min(2.0 * k_max, EnergyOptions::kLargestKMax); }
 
 // The range a frame's sweep `start` over `k_max` asks for next (SweepOptions::widen_share,
-// narrow_share), or k_max itself when the range stands. A range widens at most
-// sweep.max_widenings times, and one that widened never narrows (nor the other way round), so
-// that the search ends. `changes`: the range's changes so far, positive when it widened.
+// narrow_share), or k_max itself when the range stands: twice as wide while the range limits it,
+// or the narrowest of its halvings, down to `sigma_hat`, whose half holds the sweep's reach. A
+// range widens at most sweep.max_widenings times, and one that widened never narrows (nor the
+// other way round), so that the search ends. `changes`: the range's changes so far, positive
+// when it widened.
 double NextRange(const SweepResult& start, double k_max, double sigma_hat, int changes,
                  const SweepOptions& sweep) {
   const bool limited = sweep.widen_share > 0.0 && start.share_at_ends > sweep.widen_share &&
                        changes >= 0 && changes < sweep.max_widenings &&
                        k_max < EnergyOptions::kLargestKMax;
   if (limited) return WidenedRange(k_max);
-  const bool too_wide = sweep.narrow_share > 0.0 && changes <= 0 &&
-                        start.share_in_outer_half < sweep.narrow_share && 0.5 * k_max >= sigma_hat;
-  return too_wide ? 0.5 * k_max : k_max;
+  if (sweep.narrow_share == 0.0 || changes > 0) return k_max;
+  double range = k_max;
+  while (0.5 * range >= sigma_hat && start.reach <= 0.5 * range) range *= 0.5;
+  return range;
 }
 
 // Builds the energy of `surface` over `cameras` and, when `sweep`, finds the plane sweep's start

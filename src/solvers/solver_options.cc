@@ -108,9 +108,9 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
     f.AddInt("max_widenings", &SweepOptions::max_widenings,
              "Plane-sweep start: doublings of a frame's range (energy.k_max) at most.", 0, 20);
     f.AddDouble("narrow_share", &SweepOptions::narrow_share,
-                "Plane-sweep start: a frame's range (energy.k_max) that did not widen halves, down "
-                "to model.sigma_hat, while fewer than this share of its surface Gaussians finds "
-                "its lowest cost in the outer half of the range (0: never narrow).",
+                "Plane-sweep start: a frame's range (energy.k_max) that did not widen narrows to "
+                "its narrowest halving, down to model.sigma_hat, in whose outer half fewer than "
+                "this share of its surface Gaussians finds its lowest cost (0: never narrow).",
                 0.0, 1.0);
     return f;
   }();

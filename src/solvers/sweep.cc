@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "finecap/util/error.h"
@@ -43,6 +44,18 @@ Eigen::VectorXd SweepDisplacements(const SweepOptions& options, double k_max, do
                        1 + 2 * static_cast<int>(std::min(half, 0.5 * SweepOptions::kMaxSamples)));
   }
   return Eigen::VectorXd::LinSpaced(samples, -k_max, k_max);
+}
+
+// The distance within which all but `share` of `distances` lie: its largest entry with fewer than
+// share * size() entries above it. Infinite for none.
+double Reach(std::vector<double>* distances, double share) {
+  const int n = static_cast<int>(distances->size());
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  // The most entries that may lie above it: the largest count below share * n.
+  const int above = std::clamp(static_cast<int>(std::ceil(share * n)) - 1, 0, n - 1);
+  const auto at = distances->begin() + (n - 1 - above);
+  std::nth_element(distances->begin(), at, distances->end());
+  return *at;
 }
 
 }  // namespace
@@ -89,7 +102,8 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const double step = displacements[1] - displacements[0];
   const int last = static_cast<int>(displacements.size()) - 1;
-  int at_ends = 0, counted = 0, in_outer_half = 0;
+  int at_ends = 0;
+  std::vector<double> confident_starts;  // |k| of the confident Gaussians.
   for (int s = 0; s < n; ++s) {
     // A Gaussian whose curve is flat (no block reaches it, nor its neighbours' costs) has no
     // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
@@ -105,11 +119,10 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
       const double curvature = c0 - 2.0 * c1 + c2;
       if (curvature > 0.0) result.k[s] += 0.5 * step * (c0 - c2) / curvature;
     }
-    counted += confident;
-    in_outer_half += confident && std::abs(result.k[s]) > 0.5 * k_max;
+    if (confident) confident_starts.push_back(std::abs(result.k[s]));
   }
   result.share_at_ends = static_cast<double>(at_ends) / n;
-  result.share_in_outer_half = counted > 0 ? static_cast<double>(in_outer_half) / counted : 1.0;
+  result.reach = Reach(&confident_starts, options.narrow_share);
   return result;
 }
 

@@ -16,6 +16,8 @@
 #ifndef FINECAP_SWEEP_H_
 #define FINECAP_SWEEP_H_
 
+#include <limits>
+
 #include <Eigen/Core>
 
 #include "finecap/energy/frame_energy.h"
@@ -53,14 +55,15 @@ struct SweepOptions {
   // 5.4 % at 12 mm, 0.02 % at 24 mm).
   double widen_share = 0.01;
   int max_widenings = 4;
-  // A refinement that did not widen halves its frame's range while fewer than this share of the
-  // surface Gaussians (those refined with confidence) find their lowest cost in the outer half of
-  // the range (SweepResult::share_in_outer_half), down to sigma_hat. A range far wider than the
-  // input's error adds nothing a Gaussian needs and keeps the few that find a chance coincidence
-  // of colour far off (synth_skirt_exact: one to three Gaussians a frame beyond 12 mm, each
-  // centimetres from the truth). The share is small only where the range is wide: 0.01-0.03 % on
-  // synth_skirt_exact at 24 mm and 0.02 % on the smoothed input, against 1.1 % on the temple at
-  // 16.6 mm and on Sceaux at 203 mm, 3.5 % on synth_skirt and 2.2 % on the smoothed input at 12 mm.
+  // A refinement that did not widen narrows its frame's range to the narrowest of its halvings,
+  // down to sigma_hat, in whose outer half fewer than this share of the surface Gaussians (those
+  // refined with confidence) find their lowest cost (SweepResult::reach). A range far wider than
+  // the input's error adds nothing a Gaussian needs and keeps the few that find a chance
+  // coincidence of colour far off (synth_skirt_exact: one to three Gaussians a frame beyond
+  // 12 mm, each centimetres from the truth). The share is small only where the range is wide:
+  // 0.01-0.03 % on synth_skirt_exact at 24 mm and 0.02 % on the smoothed input, against 1.1 % on
+  // the temple at 16.6 mm and on Sceaux at 203 mm, 3.5 % on synth_skirt and 2.2 % on the smoothed
+  // input at 12 mm.
   double narrow_share = 0.002;
 
   static const OptionFields<SweepOptions>& Fields();  // option_fields.h
@@ -80,12 +83,13 @@ struct SweepResult {
   // (FrameEnergy::confidence() at least 0.5) whose window grew to the whole range and whose best
   // sample is at one of its ends: where the range, not the images, limits them.
   double share_at_ends = 0.0;
-  // Of the Gaussians refined with confidence whose curve is not flat, the share whose best
-  // displacement lies farther than half the range from k = 0: where a range half as wide would
-  // limit them. Counted among those Gaussians alone, so that a frame whose cameras can decide few
-  // of its Gaussians narrows no more readily than one whose cameras decide them all; 1 when there
-  // is none (nothing says that the range is too wide).
-  double share_in_outer_half = 1.0;
+  // How far from k = 0 the best displacements of all but SweepOptions::narrow_share of the
+  // Gaussians refined with confidence (whose curve is not flat) lie: a range whose half reaches as
+  // far would limit fewer than that share of them. Counted among those Gaussians alone, so that a
+  // frame whose cameras can decide few of its Gaussians narrows no more readily than one whose
+  // cameras decide them all; infinite when there is none (nothing says that the range is too
+  // wide).
+  double reach = std::numeric_limits<double>::infinity();
 };
 
 SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options);
