@@ -88,18 +88,11 @@ std::string RoundedCount(double count) {
   return text.str();
 }
 
-std::string Millimetres(double metres) {
-  std::ostringstream text;
-  text.precision(metres < 0.01 ? 1 : 0);
-  text << std::fixed << metres * 1e3 << " mm";
-  return text.str();
-}
-
 std::string WidestRangeForecast(const ProblemSize& size) {
   if (!(size.widest_peak_memory_mb > size.peak_memory_mb)) return "";
   return " (up to " + std::to_string(std::lround(size.widest_peak_memory_mb)) +
          " MB if a frame's plane sweep widens its search range to " +
-         Millimetres(size.widest_k_max) + ")";
+         LengthText(size.widest_k_max) + ")";
 }
 
 std::string RoundedSeconds(double seconds) {
@@ -188,7 +181,7 @@ class ConsoleObserver : public SequenceObserver {
   }
   void WidestRangeMayNotFit(const ProblemSize& size, double limit_mb) override {
     std::cerr << "finecap " << command_ << ": warning: a frame whose plane sweep widens its "
-              << "search range to " << Millimetres(size.widest_k_max) << " would need about "
+              << "search range to " << LengthText(size.widest_k_max) << " would need about "
               << std::lround(size.widest_peak_memory_mb) << " MB, more than the "
               << std::lround(limit_mb) << " MB the run may take; lower "
               << "refine.sweep.max_widenings to keep every frame within it\n";

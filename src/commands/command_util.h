@@ -48,8 +48,6 @@ Config WithSceneLengths(const Config& config, const Capture& capture, const std:
 std::string RoundedCount(double count);
 // A duration for people: "0.8 s", "12 s", "3.5 min".
 std::string RoundedSeconds(double seconds);
-// A length in millimetres, one decimal below 10 mm ("4.2 mm", "203 mm").
-std::string Millimetres(double metres);
 // " (up to N MB if a frame's plane sweep widens its search range to R)" where the sweep may widen
 // a frame's range beyond the configured one (ProblemSize::widest_k_max); empty where it may not.
 std::string WidestRangeForecast(const ProblemSize& size);
