@@ -64,8 +64,9 @@ for capture in "${captures[@]}"; do
   build/finecap refine --capture "$capture" --out "$out" --frames "$frames" "${args[@]}" \
     >"$work/stdout" 2>"$work/stderr" || { cat "$work/stderr" >&2; exit 1; }
   forecast=$(grep -o 'expected peak memory [0-9]*' "$work/stderr" | awk '{ print $4 }')
-  forecast_s=$(grep -o 'MB, about [0-9.]* [a-z]*' "$work/stderr" |
-    awk '{ print ($4 == "min") ? $3 * 60 : $3 }')
+  # "..., about T s|min per frame" (after "(up to ...)" when a frame may widen its range).
+  forecast_s=$(grep -o 'about [0-9.]* [a-z]* per frame' "$work/stderr" | head -n 1 |
+    awk '{ print ($3 == "min") ? $2 * 60 : $2 }')
   # The run's peak: the largest high-water mark of its frames; the first frame's time.
   measured=$(grep -o '"peak_rss_mb": [0-9.eE+-]*' "$out/stats.jsonl" |
     awk '{ if ($2 > m) m = $2 } END { print m }')

@@ -63,9 +63,12 @@ printf "heldout_ncc_input: %.4f\n" "$(score input "$capture/meshes/000000.ply")"
 printf "heldout_ncc_refined: %.4f\n" "$(score refined "$work/run/meshes/000000.ply")"
 
 read -r seconds kilobytes <"$work/refine.time"
-forecast=$(grep -o 'expected peak memory [0-9]* MB, about [0-9.]* [a-z]*' "$work/refine.log" | head -1)
+# "expected peak memory M MB (up to ... if ...), about T s|min per frame": the peak and time of
+# the range the run starts with; the parenthesis is there only when a frame may widen it.
+forecast=$(grep -o 'expected peak memory [0-9]* MB.*about [0-9.]* [a-z]* per frame' \
+  "$work/refine.log" | head -1)
 forecast_mb=$(echo "$forecast" | awk '{ print $4 }')
-forecast_seconds=$(echo "$forecast" | awk '{ print ($8 ~ /^min/) ? 60 * $7 : $7 }')
+forecast_seconds=$(echo "$forecast" | awk '{ print ($(NF - 2) ~ /^min/) ? 60 * $(NF - 3) : $(NF - 3) }')
 echo "refine_seconds: $seconds"
 echo "refine_peak_mb: $((kilobytes / 1024))"
 echo "forecast_peak_mb: $forecast_mb"

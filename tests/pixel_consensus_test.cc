@@ -214,6 +214,25 @@ TEST(PixelConsensusTest, ResidualJacobiansMatchCentralDifferences) {
   EXPECT_LE(disagreeing, checked / 100);
 }
 
+// Without the table of its reads' rays (too many reads for the memory it may take) every read
+// projects its sample itself, with the same arithmetic: the same values and derivatives, to the
+// bit.
+TEST(PixelConsensusTest, ReadsWithoutTheirTableGiveTheSameBits) {
+  EXPECT_EQ(SampleRayTableBytes(100.0, 4800.0), 4800.0);
+  EXPECT_EQ(SampleRayTableBytes(101.0, 4800.0), 0.0);
+  const SampledScene scene = MakeSampledScene(0.001);
+  const ConsensusOptions options = SampledOptions().consensus;
+  PixelConsensusSimilarity tabled(scene.samples, scene.cameras, options);
+  PixelConsensusSimilarity untabled(scene.samples, scene.cameras, options,
+                                    /*max_ray_table_bytes=*/0.0);
+  ASSERT_GT(tabled.residual_blocks().size(), 20u);
+  const Eigen::VectorXd k = RandomK(scene.surface.size(), 0.002, 5);
+  Eigen::VectorXd tabled_gradient, untabled_gradient;
+  EXPECT_EQ(tabled.Evaluate(k, &tabled_gradient), untabled.Evaluate(k, &untabled_gradient));
+  EXPECT_EQ(tabled_gradient, untabled_gradient);
+  EXPECT_NE(tabled_gradient.cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(PixelConsensusTest, ScalarIsMinusHalfTheSumOfTheBlockCosts) {
   const SampledScene scene = MakeSampledScene(0.001);
   FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, SampledOptions(),

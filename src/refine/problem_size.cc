@@ -189,9 +189,10 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
     size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
     size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
-    detail_bytes =
-        size.num_pixels * kBytesPerSampledPixel + size.num_surface_samples * kBytesPerSurfaceSample;
-    detail_seconds = size.num_observations * double(size.samples_per_patch) * kSecondsPerSampleRead;
+    const double reads = size.num_observations * double(size.samples_per_patch);
+    detail_bytes = size.num_pixels * kBytesPerSampledPixel +
+                   size.num_surface_samples * kBytesPerSurfaceSample + SampleRayTableBytes(reads);
+    detail_seconds = reads * kSecondsPerSampleRead;
   }
   const bool cholesky = options.solver.type == SolverType::kCeres &&
                         options.solver.linear_solver != LinearSolverType::kCgnr;

@@ -69,6 +69,16 @@ struct SurfaceSamples {
   int size() const { return static_cast<int>(base.cols()); }
 };
 
+// The bytes the consensus similarity keeps to read its samples faster: the homogeneous pixel of
+// each sample read by a patch in a camera and its derivative along the sample's normal (48 bytes
+// a read), when they come to at most `max_table_bytes`, else none: each read then projects its
+// sample anew, about a quarter slower (a detail-stage evaluation of synth_skirt: 27 against 36
+// ms), with the same results. The default, 512 MB, keeps the table of captures of a few
+// megapixels (Sceaux at 708 x 532: 7 M reads, 340 MB) and drops it where it would outweigh all
+// the rest (Sceaux at 2832 x 2128: 135 M reads, 6.5 GB, against 2.7 GB for everything else).
+constexpr double kMaxSampleRayTableBytes = 512e6;
+double SampleRayTableBytes(double num_reads, double max_table_bytes = kMaxSampleRayTableBytes);
+
 // The options of the pair lists the energy builds with `options` (gaussian_pairs.h).
 PairOptions EnergyPairOptions(const EnergyOptions& options);
 

@@ -97,6 +97,11 @@ Eigen::Matrix<double, 3, 4> ProjectionOf(const Camera& camera) {
 
 }  // namespace
 
+double SampleRayTableBytes(double num_reads, double max_table_bytes) {
+  const double bytes = num_reads * sizeof(Eigen::Vector3d) * 2;
+  return bytes <= max_table_bytes ? bytes : 0.0;
+}
+
 Eigen::Matrix3Xd SeenAppearance(const SurfaceSamples& samples,
                                 const std::vector<CameraInput>& cameras,
                                 const Eigen::VectorXd& shape) {
@@ -127,7 +132,8 @@ Eigen::Matrix3Xd SeenAppearance(const SurfaceSamples& samples,
 
 PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples,
                                                    const std::vector<CameraInput>& cameras,
-                                                   const ConsensusOptions& options)
+                                                   const ConsensusOptions& options,
+                                                   double max_ray_table_bytes)
     : PatchAgreementTerm(options, static_cast<int>(cameras.size())),
       samples_(samples),
       cameras_(cameras),
@@ -164,7 +170,7 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
   }
   shape_ = Eigen::VectorXd::Zero(samples.size());
   parameter_shape_ = Eigen::VectorXd::Zero(samples.patches.size());
-  ProjectReads();
+  ProjectReads(max_ray_table_bytes);
   WeighPatches();
 }
 
@@ -213,12 +219,14 @@ bool PixelConsensusSimilarity::AppearanceKnown(const std::vector<int>& members) 
                      [&](int j) { return samples_.appearance.col(j).allFinite(); });
 }
 
-void PixelConsensusSimilarity::ProjectReads() {
+void PixelConsensusSimilarity::ProjectReads(double max_table_bytes) {
   const int num_blocks = static_cast<int>(blocks_.size());
   read_begin_.assign(1, 0);
   for (int b = 0; b < num_blocks; ++b) {
     read_begin_.push_back(read_begin_.back() + static_cast<long>(PatchSize(b)) * NumCameras(b));
   }
+  rays_.clear();
+  if (SampleRayTableBytes(static_cast<double>(read_begin_.back()), max_table_bytes) == 0.0) return;
   rays_.resize(read_begin_.back());
 #pragma omp parallel for schedule(dynamic, 64)
   for (int b = 0; b < num_blocks; ++b) {
@@ -227,27 +235,34 @@ void PixelConsensusSimilarity::ProjectReads() {
     for (int a = 0; a < num_cameras; ++a) {
       const int c = Cameras(b)[a];
       if (c == appearance_view_) continue;
-      const Eigen::Matrix<double, 3, 4>& projection = projections_[c];
-      for (int m = 0; m < n; ++m) {
-        SampleRay& ray = rays_[read_begin_[b] + a * n + m];
-        ray.direction = projection.leftCols<3>() * samples_.normals.col(members[m]);
-        ray.at_zero = projection.leftCols<3>() * samples_.base.col(members[m]) + projection.col(3);
-      }
+      for (int m = 0; m < n; ++m) rays_[read_begin_[b] + a * n + m] = RayOf(c, members[m]);
     }
   }
 }
 
+PixelConsensusSimilarity::SampleRay PixelConsensusSimilarity::RayOf(int camera, int sample) const {
+  const Eigen::Matrix<double, 3, 4>& projection = projections_[camera];
+  return {projection.leftCols<3>() * samples_.base.col(sample) + projection.col(3),
+          projection.leftCols<3>() * samples_.normals.col(sample)};
+}
+
 void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
                                            double* derivatives) const {
-  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  const int n = PatchSize(b);
   const int* members = Members(b);
   const double centre_shape = parameter_shape_[blocks_[b].parameters[0]];
-  // A member's displacement is the same in every camera.
   thread_local std::vector<double> member_k;
-  thread_local std::vector<BilinearCell> cells;
   member_k.resize(n);
-  cells.resize(n);
   for (int m = 0; m < n; ++m) member_k[m] = k + shape_[members[m]] - centre_shape;
+  ReadPatch(b, member_k.data(), colors, derivatives);
+}
+
+void PixelConsensusSimilarity::ReadPatch(int b, const double* member_k, double* colors,
+                                         double* derivatives) const {
+  const int n = PatchSize(b), num_cameras = NumCameras(b);
+  const int* members = Members(b);
+  thread_local std::vector<BilinearCell> cells;
+  cells.resize(n);
   for (int a = 0; a < num_cameras; ++a) {
     const int c = Cameras(b)[a];
     if (c == appearance_view_) {
@@ -265,12 +280,13 @@ void PixelConsensusSimilarity::PatchColors(int b, double k, double* colors,
     // pixel h_xy / h_z and its k-derivative (h'_xy - pixel h'_z) / h_z need no more than it.
     // Every member's cell first and its pixels asked of memory, then the reads: the image is
     // mostly not in the nearest caches, and the reads' waits then overlap.
-    const SampleRay* rays = &rays_[read_begin_[b] + a * n];
+    const SampleRay* rays = rays_.empty() ? nullptr : &rays_[read_begin_[b] + a * n];
     const cv::Mat& image = cameras_[c].pixels;
     const long row_step = RowStep(image);
     for (int m = 0; m < n; ++m) {
       double x, y, dx, dy;
-      PixelOnRay(rays[m].at_zero, rays[m].direction, member_k[m], &x, &y, &dx, &dy);
+      const SampleRay ray = rays != nullptr ? rays[m] : RayOf(c, members[m]);
+      PixelOnRay(ray.at_zero, ray.direction, member_k[m], &x, &y, &dx, &dy);
       cells[m] = CellAt(image, x, y, dx, dy);
       __builtin_prefetch(cells[m].top);
       __builtin_prefetch(cells[m].top + row_step);

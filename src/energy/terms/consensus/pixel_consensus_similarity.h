@@ -53,12 +53,22 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // `samples` and `cameras` must outlive this object; `cameras[c].samples_visible` has one flag
   // per sample and `cameras[c].pixels` is the camera's image in the similarity's colour space
   // (CV_32FC3), blurred (ConsensusOptions::sample_blur).
+  // The reads' rays are kept when they come to at most `max_ray_table_bytes`
+  // (SampleRayTableBytes).
   PixelConsensusSimilarity(const SurfaceSamples& samples, const std::vector<CameraInput>& cameras,
-                           const ConsensusOptions& options);
+                           const ConsensusOptions& options,
+                           double max_ray_table_bytes = kMaxSampleRayTableBytes);
 
   // The patches' shape, one entry per surface Gaussian, carried to the samples by
   // SurfaceSamples::weights: sample j of patch s is read at k_s + shape_j - shape_s.
   void SetPatchShape(const Eigen::VectorXd& shape) override;
+
+  // Block b's colours in its cameras (camera after camera, member after member, channel after
+  // channel) with member m of its patch at displacement member_k[m] along its normal, whatever
+  // the patch's shape, and, when `derivatives` is not null, each colour's derivative in its own
+  // member's displacement: the reads of a term that moves the samples otherwise
+  // (SurfaceConsensusSimilarity).
+  void ReadPatch(int b, const double* member_k, double* colors, double* derivatives) const;
 
  private:
   void PatchColors(int b, double k, double* colors, double* derivatives) const override;
@@ -67,8 +77,8 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // (CameraInput::samples_on_foreground); with no masks, every camera that sees it, on all of it.
   void ComparablePart(const std::vector<int>& patch, std::vector<int>* seen_by,
                       std::vector<int>* members) const;
-  // Sets rays_ for every block's reads.
-  void ProjectReads();
+  // Sets rays_ for every block's reads, when they fit within `max_table_bytes`.
+  void ProjectReads(double max_table_bytes);
 
   // Whether the patch's members all have a known appearance (SurfaceSamples::appearance).
   bool AppearanceKnown(const std::vector<int>& members) const;
@@ -86,10 +96,13 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
   // after member (the order of PatchColors), from read_begin_[b]; none is read for the
   // appearance's view. Laid out in the order the evaluation reads them, they stream from memory,
   // where the samples' positions and normals were gathered from all over theirs.
+  // Empty when the reads are too many to keep (SampleRayTableBytes): each read then projects
+  // its sample itself (RayOf), with the same arithmetic and so the same bits.
   struct SampleRay {
     Eigen::Vector3d at_zero;
     Eigen::Vector3d direction;
   };
+  SampleRay RayOf(int camera, int sample) const;
   std::vector<SampleRay> rays_;
   std::vector<long> read_begin_;
   Eigen::VectorXd shape_;            // Per sample.
