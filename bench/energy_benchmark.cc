@@ -148,6 +148,26 @@ void BM_DetailBlockSummaries(benchmark::State& state) {
 }
 BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
+// The detail stage's second term (energy.consensus.surface_weight: the refined mesh itself, each
+// sample moved with its face's corners): its reduced rows with their Jacobians where the stage
+// starts, as BM_DetailBlockSummaries.
+void BM_DetailSurfaceRows(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  const int threads = state.range(0) > 0 ? static_cast<int>(state.range(0)) : omp_get_num_procs();
+  RefineOptions options;
+  options.energy.consensus.surface_weight = 1.0;
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
+  PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  DataTerm& surface = frame.energy->data_term(1);
+  omp_set_num_threads(threads);
+  for (auto _ : state) surface.PrepareResiduals(k, /*with_jacobians=*/true);
+  omp_set_num_threads(omp_get_num_procs());
+  state.counters["threads"] = threads;
+  state.counters["blocks"] = static_cast<double>(surface.residual_blocks().size());
+}
+BENCHMARK(BM_DetailSurfaceRows)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
 // One solve of a prepared frame with Ceres and the linear solver named, from the plane sweep's
 // start, as the first of a frame's passes: the solver's own work around the evaluations, beside
 // BM_EnergyAndGradient's evaluation alone. Real time: the solve runs on all threads.

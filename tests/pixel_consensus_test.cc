@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "energy/terms/consensus/pixel_consensus_similarity.h"
+#include "energy/terms/consensus/surface_consensus_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/energy/frame_energy.h"
 #include "finecap/util/error.h"
@@ -422,6 +424,190 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
   EXPECT_THROW(
       FrameEnergy(scene.surface, scene.cameras, scene.neighbourhoods, options, scene.samples),
       Error);
+}
+
+// The second term of the detail stage (surface_consensus_similarity.h): the same patches read
+// with every sample where the blend of its face's corners puts it.
+struct SurfaceTermScene {
+  explicit SurfaceTermScene(double truth_offset, double weight = 1.0, bool pooled_gain = false)
+      : scene(MakeSampledScene(truth_offset)),
+        options(Weighted(weight, pooled_gain)),
+        patches(scene.samples, scene.cameras, options),
+        surface(patches, scene.samples, options) {}
+  static ConsensusOptions Weighted(double weight, bool pooled_gain) {
+    ConsensusOptions options = SampledOptions().consensus;
+    options.surface_weight = weight;
+    options.gain_per_channel = !pooled_gain;
+    return options;
+  }
+  SampledScene scene;
+  ConsensusOptions options;
+  PixelConsensusSimilarity patches;
+  SurfaceConsensusSimilarity surface;
+};
+
+TEST(SurfaceConsensusTest, TheDetailStageSumsItWithThePatchesWhenItHasAWeight) {
+  const SampledScene scene = MakeSampledScene(0.001);
+  EnergyOptions options = SampledOptions();
+  options.consensus.surface_weight = 1.0;
+  const FrameEnergy both(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                         scene.samples);
+  ASSERT_EQ(both.num_data_terms(), 2);
+  EXPECT_EQ(both.data_term(0).residual_blocks()[0].parameters.size(), 1u);
+  size_t widest = 0;
+  for (const auto& block : both.data_term(1).residual_blocks()) {
+    widest = std::max(widest, block.parameters.size());
+  }
+  EXPECT_EQ(widest, 7u);  // An inner vertex of the grid and its six neighbours.
+  options.consensus.surface_weight = 0.0;
+  const FrameEnergy patches(scene.surface, scene.cameras, scene.neighbourhoods, options,
+                            scene.samples);
+  EXPECT_EQ(patches.num_data_terms(), 1);
+}
+
+// A block depends on its vertex and the corners of its faces: every unknown a sample of the
+// patch is blended from, and those only.
+TEST(SurfaceConsensusTest, ABlockDependsOnTheCornersOfItsSamples) {
+  const SurfaceTermScene t(0.001);
+  const auto& blocks = t.surface.residual_blocks();
+  ASSERT_EQ(blocks.size(), t.patches.residual_blocks().size());
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    std::vector<int> corners;
+    const int* members = t.patches.Members(static_cast<int>(b));
+    for (int j = 0; j < t.patches.PatchSize(static_cast<int>(b)); ++j) {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(t.scene.samples.weights,
+                                                                          members[j]);
+           it; ++it) {
+        corners.push_back(static_cast<int>(it.col()));
+      }
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    EXPECT_EQ(blocks[b].parameters, corners) << "block " << b;
+    EXPECT_EQ(blocks[b].num_residuals, static_cast<int>(corners.size()) + 1);
+    // The patch's own vertex is one of them.
+    EXPECT_TRUE(std::binary_search(corners.begin(), corners.end(),
+                                   t.patches.residual_blocks()[b].parameters[0]));
+  }
+}
+
+TEST(SurfaceConsensusTest, GradientMatchesCentralDifferences) {
+  const SurfaceTermScene t(0.0015);
+  int disagreeing = 0, checked = 0;
+  for (unsigned trial = 0; trial < 3; ++trial) {
+    const Eigen::VectorXd k = RandomK(t.scene.surface.size(), 0.002, trial);
+    Eigen::VectorXd analytic;
+    t.surface.Evaluate(k, &analytic);
+    const Eigen::VectorXd numeric = NumericGradient(
+        [&](const Eigen::VectorXd& x) { return t.surface.Evaluate(x, nullptr); }, k, 1e-8);
+    ASSERT_GT(numeric.cwiseAbs().maxCoeff(), 0.0);
+    for (int s = 0; s < k.size(); ++s) {
+      disagreeing += std::abs(analytic[s] - numeric[s]) > 1e-4 * numeric.cwiseAbs().maxCoeff();
+      ++checked;
+    }
+  }
+  EXPECT_LE(disagreeing, checked / 50);
+}
+
+TEST(SurfaceConsensusTest, ResidualJacobiansMatchCentralDifferences) {
+  const SurfaceTermScene t(0.001, /*weight=*/2.0);
+  const Eigen::VectorXd k = RandomK(t.scene.surface.size(), 0.002, 3);
+  const double h = 1e-8;
+  int checked = 0, disagreeing = 0;
+  for (int b = 0; b < static_cast<int>(t.surface.residual_blocks().size()); b += 5) {
+    const std::vector<int>& unknowns = t.surface.residual_blocks()[b].parameters;
+    Eigen::VectorXd residuals, plus, minus;
+    Eigen::MatrixXd jacobian;
+    t.surface.ResidualsOfBlock(b, k, &residuals, &jacobian);
+    ASSERT_EQ(jacobian.cols(), static_cast<Eigen::Index>(unknowns.size()));
+    const double scale = std::max(jacobian.cwiseAbs().maxCoeff(), 1e-12);
+    for (size_t i = 0; i < unknowns.size(); ++i) {
+      Eigen::VectorXd shifted = k;
+      shifted[unknowns[i]] += h;
+      t.surface.ResidualsOfBlock(b, shifted, &plus, nullptr);
+      shifted[unknowns[i]] -= 2 * h;
+      t.surface.ResidualsOfBlock(b, shifted, &minus, nullptr);
+      for (Eigen::Index r = 0; r < residuals.size(); ++r) {
+        const double numeric = (plus[r] - minus[r]) / (2 * h);
+        disagreeing += std::abs(numeric - jacobian(r, i)) > 1e-4 * scale;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 1000);
+  EXPECT_LE(disagreeing, checked / 100);
+}
+
+// What a solver takes of a block, its rows and their Jacobian, has the block's cost, gradient
+// J^T r and Gauss-Newton matrix J^T J (summed over its members and cameras, not from its
+// Jacobian: with one gain per camera and channel, and one per camera); and the term's value is
+// minus half the sum of the costs.
+class SurfaceRowsTest : public testing::TestWithParam<bool> {};
+
+TEST_P(SurfaceRowsTest, ReducedRowsKeepTheBlocksCostGradientAndCurvature) {
+  SurfaceTermScene t(0.001, /*weight=*/2.0, /*pooled_gain=*/GetParam());
+  const Eigen::VectorXd k = RandomK(t.scene.surface.size(), 0.002, 6);
+  t.surface.PrepareResiduals(k, true);
+  double sum = 0.0;
+  for (int b = 0; b < static_cast<int>(t.surface.residual_blocks().size()); ++b) {
+    const int p = static_cast<int>(t.surface.residual_blocks()[b].parameters.size());
+    const int num_rows = t.surface.residual_blocks()[b].num_residuals;
+    Eigen::VectorXd rows(num_rows);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> reduced(num_rows, p);
+    t.surface.BlockResiduals(b, rows.data(), reduced.data());
+    Eigen::VectorXd residuals;
+    Eigen::MatrixXd jacobian;
+    t.surface.ResidualsOfBlock(b, k, &residuals, &jacobian);
+    const double cost = residuals.squaredNorm();
+    const Eigen::MatrixXd curvature = jacobian.transpose() * jacobian;
+    const double tolerance = 1e-9 * std::max(curvature.cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_NEAR(rows.squaredNorm(), cost, 1e-9 * std::max(cost, 1e-12)) << "block " << b;
+    const Eigen::VectorXd gradient = jacobian.transpose() * residuals;
+    EXPECT_LE((reduced.transpose() * rows - gradient).cwiseAbs().maxCoeff(),
+              1e-7 * std::max(gradient.cwiseAbs().maxCoeff(), 1e-12))
+        << "block " << b;
+    EXPECT_LE((reduced.transpose() * reduced - curvature).cwiseAbs().maxCoeff(), tolerance)
+        << "block " << b;
+    sum += cost;
+  }
+  EXPECT_GT(sum, 0.0);
+  EXPECT_NEAR(t.surface.Evaluate(k, nullptr), -0.5 * sum, 1e-9 * sum);
+  std::vector<double> costs;
+  t.surface.BlockCosts(k, &costs);
+  EXPECT_NEAR(std::accumulate(costs.begin(), costs.end(), 0.0), sum, 1e-9 * sum);
+}
+
+INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, SurfaceRowsTest, testing::Bool(),
+                         [](const testing::TestParamInfo<bool>& info) {
+                           return info.param ? "PooledGain" : "GainPerChannel";
+                         });
+
+// With every k the same the refined mesh is the input surface moved as a whole, as each patch
+// is: the two terms agree block by block, the surface term times its weight.
+TEST(SurfaceConsensusTest, WithEveryKTheSameItIsThePatchTermTimesItsWeight) {
+  SurfaceTermScene t(0.0012, /*weight=*/3.0);
+  const Eigen::VectorXd k = Eigen::VectorXd::Constant(t.scene.surface.size(), 0.0007);
+  std::vector<double> patch_costs, surface_costs;
+  t.patches.BlockCosts(k, &patch_costs);
+  t.surface.BlockCosts(k, &surface_costs);
+  ASSERT_EQ(patch_costs.size(), surface_costs.size());
+  for (size_t b = 0; b < patch_costs.size(); ++b) {
+    EXPECT_NEAR(surface_costs[b], 3.0 * patch_costs[b], 1e-9 * std::max(patch_costs[b], 1e-12))
+        << "block " << b;
+  }
+}
+
+// The mesh on the textured plane compares better than the same mesh tilted or roughened.
+TEST(SurfaceConsensusTest, TheTruthScoresBetterThanATiltOrNoise) {
+  const SurfaceTermScene t(0.0);
+  // The cameras see the plane z = 0; the grid's normals point to -z, so k = 0 is the truth.
+  const Eigen::VectorXd truth = Eigen::VectorXd::Zero(t.scene.surface.size());
+  const double at_truth = t.surface.Evaluate(truth, nullptr);
+  Eigen::VectorXd tilted(t.scene.surface.size());
+  for (int s = 0; s < tilted.size(); ++s) tilted[s] = 0.05 * t.scene.surface.base(0, s);
+  EXPECT_LT(t.surface.Evaluate(tilted, nullptr), at_truth);
+  const Eigen::VectorXd step = RandomK(t.scene.surface.size(), 0.0005, 2);
+  EXPECT_LT(t.surface.Evaluate(step, nullptr), at_truth);
 }
 
 }  // namespace

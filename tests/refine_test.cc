@@ -126,6 +126,31 @@ TEST_F(RefineFrameTest, TheDetailStageReadsTheCamerasWithinItsOwnAngle) {
   EXPECT_THROW(PrepareDetailEnergy(model, input, defaults, too_short, &frame), Error);
 }
 
+// With energy.consensus.surface_weight the detail stage compares the refined mesh itself beside
+// the patches: its energy has the second term, the solve ends above where it started, and the
+// surface differs from the patches' alone.
+TEST_F(RefineFrameTest, TheRefinedMeshTermJoinsTheDetailStage) {
+  Capture capture = Capture::Open(*directory_);
+  RefineOptions options;
+  options.solver.max_iterations = 5;
+  const FrameInput input = ReadFrameInput(&capture, 0);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, input, options);
+  const FrameResult patches = RefineFrame(model, colors, input, options);
+  options.energy.consensus.surface_weight = 1.0;
+  const FrameResult both = RefineFrame(model, colors, input, options);
+  EXPECT_GT(both.summary.energy_end, both.summary.energy_start);
+  EXPECT_FALSE(both.worse);
+  const Eigen::VectorXd difference = both.k - patches.k;
+  EXPECT_EQ(difference.array().isNaN().count(), patches.k.array().isNaN().count());
+  EXPECT_GT(difference.array().isFinite().select(difference, 0.0).norm(), 0.0);
+
+  PreparedFrame frame = PrepareFrame(model, colors, input, options);
+  PrepareDetailEnergy(model, input, options, both.k_solved, &frame);
+  ASSERT_EQ(frame.energy->num_data_terms(), 2);
+  EXPECT_GT(frame.energy->data_term(1).residual_blocks().front().parameters.size(), 1u);
+}
+
 // The plane sweep sets the range a frame is solved in from what it finds: a range far narrower
 // than the input's error limits many Gaussians and widens, one far wider than it holds almost
 // every Gaussian's best displacement in its inner half and narrows, never below sigma_hat. With

@@ -108,6 +108,12 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
                 "Consensus similarity with samples: standard deviation (pixels) of the blur of the "
                 "images the samples read.",
                 0.0, 8.0);
+    f.AddDouble("surface_weight", &ConsensusOptions::surface_weight,
+                "Consensus similarity with samples: weight of a second term that compares the "
+                "refined mesh itself, each sample moved with the corners of its face, beside the "
+                "patches moved as wholes; 0: the patches alone (1: every capture measured gains, "
+                "at 2 to 3 times the time).",
+                0.0, 100.0);
     f.AddBool("shared_appearance", &ConsensusOptions::shared_appearance,
               "Consensus similarity with samples: compare each patch also with the colours the "
               "frame before's refined surface showed at its samples (the appearance shared by "

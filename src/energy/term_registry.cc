@@ -2,6 +2,7 @@
 
 #include "energy/terms/consensus/consensus_similarity.h"
 #include "energy/terms/consensus/pixel_consensus_similarity.h"
+#include "energy/terms/consensus/surface_consensus_similarity.h"
 #include "energy/terms/paper/paper_similarity.h"
 #include "energy/terms/prior/input_prior.h"
 #include "energy/terms/smoothness/smoothness_term.h"
@@ -35,14 +36,6 @@ std::vector<std::vector<int>> SurfaceRings(const SurfaceGaussians& surface,
 std::unique_ptr<DataTerm> MakeSimilarity(const DataTermContext& context) {
   const EnergyOptions& options = context.options;
   const OverlapForm form = options.overlap;
-  if (context.samples.size() > 0) {
-    Require(options.similarity == SimilarityType::kConsensus, "energy.similarity",
-            "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
-    auto term = std::make_unique<PixelConsensusSimilarity>(context.samples, context.sample_cameras,
-                                                           options.consensus);
-    term->SmoothShapesOver(&context.neighbours);
-    return term;
-  }
   if (options.similarity == SimilarityType::kPaper)
     return std::make_unique<PaperSimilarity>(context.surface, context.views, form);
   if (options.similarity == SimilarityType::kConsensus) {
@@ -56,9 +49,30 @@ std::unique_ptr<DataTerm> MakeSimilarity(const DataTermContext& context) {
   return std::make_unique<SurfaceColorSimilarity>(context.surface, context.views, form);
 }
 
+// The detail stage's terms, which read the surface samples: the patches moved as wholes and,
+// with a weight, the refined mesh itself read through the same patches.
+std::vector<std::unique_ptr<DataTerm>> SampledTerms(const DataTermContext& context) {
+  const ConsensusOptions& options = context.options.consensus;
+  Require(context.options.similarity == SimilarityType::kConsensus, "energy.similarity",
+          "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
+  auto patches =
+      std::make_unique<PixelConsensusSimilarity>(context.samples, context.sample_cameras, options);
+  patches->SmoothShapesOver(&context.neighbours);
+  std::vector<std::unique_ptr<DataTerm>> terms;
+  if (options.surface_weight > 0.0) {
+    terms.push_back(
+        std::make_unique<SurfaceConsensusSimilarity>(*patches, context.samples, options));
+  }
+  // The patches first, as the energy sums its terms; the surface term reads through them, and
+  // both live as long as the energy.
+  terms.insert(terms.begin(), std::move(patches));
+  return terms;
+}
+
 }  // namespace
 
 std::vector<std::unique_ptr<DataTerm>> MakeDataTerms(const DataTermContext& context) {
+  if (context.samples.size() > 0) return SampledTerms(context);
   std::vector<std::unique_ptr<DataTerm>> terms;
   terms.push_back(MakeSimilarity(context));
   return terms;

@@ -54,6 +54,12 @@ struct ConsensusOptions {
   double sample_spacing = 1.0;
   // The samples read the blurred images by bilinear interpolation.
   double sample_blur = 0.4;
+  // With samples: the weight of the detail stage's second term, which compares the refined mesh
+  // itself (each sample where the blend of its face's corners' k puts it;
+  // SurfaceConsensusSimilarity), beside the patches moved as wholes; 0: the patches alone. 1
+  // gains on every capture measured but takes 2 to 3 times a frame's time (docs/measurements.md,
+  // 2026-12-06), so it is off by default until it is cheaper.
+  double surface_weight = 0.0;
   // The surface's appearance is the same in every frame while its shape changes: with it on, the
   // colours the frame before's refined surface showed at each sample (averaged over the cameras
   // that saw it; SurfaceSamples::appearance) are one more view every patch is compared with, so

@@ -31,7 +31,7 @@ struct CauchyScaling {
 
 }  // namespace
 
-void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
+void NormaliseColors(int n, double floor, bool pooled, double* q, double* inverse_deviation) {
   double mean[3] = {0.0, 0.0, 0.0}, variance[3] = {0.0, 0.0, 0.0};
   for (int m = 0; m < n; ++m) {
     for (int channel = 0; channel < 3; ++channel) mean[channel] += q[3 * m + channel];
@@ -45,7 +45,6 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
   }
   for (double& value : variance) value /= n;
   if (pooled) std::fill_n(variance, 3, (variance[0] + variance[1] + variance[2]) / 3.0);
-  double inverse_deviation[3];
   for (int channel = 0; channel < 3; ++channel) {
     inverse_deviation[channel] = 1.0 / std::sqrt(variance[channel] + floor * floor);
   }
@@ -54,12 +53,15 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
       q[3 * m + channel] = (q[3 * m + channel] - mean[channel]) * inverse_deviation[channel];
     }
   }
-  if (dq == nullptr) return;
+}
+
+void NormaliseDerivative(int n, bool pooled, const double* z, const double* inverse_deviation,
+                         double* dq) {
   double mean_derivative[3] = {0.0, 0.0, 0.0}, z_dot_dq[3] = {0.0, 0.0, 0.0};
   for (int m = 0; m < n; ++m) {
     for (int channel = 0; channel < 3; ++channel) {
       mean_derivative[channel] += dq[3 * m + channel];
-      z_dot_dq[channel] += q[3 * m + channel] * dq[3 * m + channel];
+      z_dot_dq[channel] += z[3 * m + channel] * dq[3 * m + channel];
     }
   }
   for (int channel = 0; channel < 3; ++channel) {
@@ -71,20 +73,21 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
     for (int channel = 0; channel < 3; ++channel) {
       double& derivative = dq[3 * m + channel];
       derivative =
-          (derivative - mean_derivative[channel] - q[3 * m + channel] * z_dot_dq[channel]) *
+          (derivative - mean_derivative[channel] - z[3 * m + channel] * z_dot_dq[channel]) *
           inverse_deviation[channel];
     }
   }
 }
 
-void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
-                        const Eigen::Vector3d& weight, double* residuals, double* jacobian) {
+void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
+  double inverse_deviation[3];
+  NormaliseColors(n, floor, pooled, q, inverse_deviation);
+  if (dq != nullptr) NormaliseDerivative(n, pooled, q, inverse_deviation, dq);
+}
+
+void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values) {
   const int stride = 3 * n;  // From one camera's patch to the next.
-  for (int a = 0; a < num_cameras; ++a) {
-    Normalise(n, floor, pooled, residuals + stride * a,
-              jacobian != nullptr ? jacobian + stride * a : nullptr);
-  }
-  const auto against_mean = [&](double* values, int m) {
+  for (int m = 0; m < n; ++m) {
     double mean[3] = {0.0, 0.0, 0.0};
     for (int a = 0; a < num_cameras; ++a) {
       for (int channel = 0; channel < 3; ++channel)
@@ -96,11 +99,18 @@ void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
         value = weight[channel] * (value - mean[channel] / num_cameras);
       }
     }
-  };
-  for (int m = 0; m < n; ++m) {
-    against_mean(residuals, m);
-    if (jacobian != nullptr) against_mean(jacobian, m);
   }
+}
+
+void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
+                        const Eigen::Vector3d& weight, double* residuals, double* jacobian) {
+  const int stride = 3 * n;
+  for (int a = 0; a < num_cameras; ++a) {
+    Normalise(n, floor, pooled, residuals + stride * a,
+              jacobian != nullptr ? jacobian + stride * a : nullptr);
+  }
+  AgainstCameraMean(n, num_cameras, weight, residuals);
+  if (jacobian != nullptr) AgainstCameraMean(n, num_cameras, weight, jacobian);
 }
 
 Eigen::Vector3d PatchContrast(int n, int num_cameras, const double* colors) {
@@ -155,6 +165,21 @@ BlockSummary Robustify(double c2, const BlockSummary& plain, bool with_derivativ
   robust.curvature = alpha * alpha * plain.curvature + 2.0 * alpha * dalpha_dk * plain.gradient +
                      dalpha_dk * dalpha_dk * plain.squared_norm;
   return robust;
+}
+
+void Robustify(double c2, double* squared_norm, Eigen::VectorXd* gradient,
+               Eigen::MatrixXd* curvature) {
+  if (c2 <= 0.0) return;
+  // As for one unknown, with a' = (d alpha / ds) 2 g a vector: the robust Jacobian is
+  // alpha J + r a'^T, whose Gram matrix and product with alpha r these are.
+  const CauchyScaling scaling(c2, *squared_norm);
+  const double alpha = scaling.alpha, s = *squared_norm;
+  const Eigen::VectorXd dalpha_dk = scaling.dalpha_ds * 2.0 * *gradient;
+  const Eigen::MatrixXd cross = alpha * dalpha_dk * gradient->transpose();
+  *curvature = alpha * alpha * *curvature + cross + cross.transpose() +
+               s * dalpha_dk * dalpha_dk.transpose();
+  *gradient = alpha * alpha * *gradient + alpha * s * dalpha_dk;
+  *squared_norm = alpha * alpha * s;
 }
 
 }  // namespace internal

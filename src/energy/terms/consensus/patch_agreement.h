@@ -22,6 +22,16 @@ namespace internal {
 // dz_m/dk = (dq_m/dk - mean dq/dk - z_m <z, dq/dk>) / deviation, where <z, dq/dk> is the mean
 // over the patch (and the channels, when pooled) of z_j dq_j/dk.
 void Normalise(int n, double floor, bool pooled, double* q, double* dq);
+// Normalise in two halves, for colours with several derivatives: the colours, in place, leaving
+// the inverse deviation of each channel in inverse_deviation[3]; then one derivative dq/dk, in
+// place, from the normalised colours z and those inverse deviations.
+void NormaliseColors(int n, double floor, bool pooled, double* q, double* inverse_deviation);
+void NormaliseDerivative(int n, bool pooled, const double* z, const double* inverse_deviation,
+                         double* dq);
+
+// Each member's values in a patch of n members seen by `num_cameras` cameras (laid out as
+// AgreementResiduals' colours) against the cameras' mean, times `weight` per channel, in place.
+void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values);
 
 // Turns, in place, the colours of a patch of n members in `num_cameras` cameras (camera after
 // camera, member after member, channel after channel) and, when `jacobian` is not null, their
@@ -46,6 +56,11 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
 // The summary of a block's residuals after Robustify from that of its residuals before it,
 // without either.
 BlockSummary Robustify(double c2, const BlockSummary& plain, bool with_derivatives);
+
+// The same for a block of several unknowns, in place: its sum of squares s, gradient J^T r and
+// Gauss-Newton matrix J^T J after the loss, from those before it.
+void Robustify(double c2, double* squared_norm, Eigen::VectorXd* gradient,
+               Eigen::MatrixXd* curvature);
 
 }  // namespace internal
 
@@ -87,6 +102,16 @@ class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
   // The weight w_s of each block, per channel (the patch's contrast at the input surface).
   const std::vector<Eigen::Vector3d>& block_weights() const { return weights_; }
 
+  // What a term that compares the same patches another way needs of them
+  // (SurfaceConsensusSimilarity): block b's members (its own first) and cameras, the weight per
+  // channel of its residuals (w_s over the root of the frame's cameras) and the scale c2 of its
+  // robust loss (none when not positive).
+  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
+  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
+  const int* Members(int b) const { return &members_[patch_begin_[b]]; }
+  Eigen::Vector3d ResidualWeight(int b) const { return scale_ * weights_[b]; }
+  double LossScale(int b) const;
+
  protected:
   // `num_cameras`: the frame's, whose square root divides every residual.
   PatchAgreementTerm(const ConsensusOptions& options, int num_cameras);
@@ -102,12 +127,7 @@ class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
   // added and PatchColors can read them.
   void WeighPatches();
 
-  int PatchSize(int b) const { return patch_begin_[b + 1] - patch_begin_[b]; }
-  int NumCameras(int b) const { return camera_begin_[b + 1] - camera_begin_[b]; }
-  const int* Members(int b) const { return &members_[patch_begin_[b]]; }
   const int* Cameras(int b) const { return &cameras_[camera_begin_[b]]; }
-  // The scale c2 of block b's robust loss (none when not positive).
-  double LossScale(int b) const;
   // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
   // applied to the sums instead of to every residual: what the solvers and the sweep need.
   BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
