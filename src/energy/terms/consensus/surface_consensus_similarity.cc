@@ -7,11 +7,15 @@
 #include <Eigen/SparseCore>
 
 #include "energy/terms/consensus/patch_agreement.h"
+#include "finecap/util/error.h"
 
 namespace finecap {
 namespace {
 
 using SampleWeights = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+// A sample lies on a triangle: its blend has at most three corners.
+constexpr int kMaxCorners = 3;
 
 // The reduced rows of a block (surface_consensus_similarity.h): `rows` (p + 1) and their
 // Jacobian `jacobian` ((p + 1) x p, row-major) from its cost s, gradient g and Gauss-Newton
@@ -55,6 +59,8 @@ SurfaceConsensusSimilarity::SurfaceConsensusSimilarity(const PixelConsensusSimil
     std::vector<int> unknowns;
     const int* members = patches.Members(b);
     for (int j = 0; j < patches.PatchSize(b); ++j) {
+      Require(samples.weights.row(members[j]).nonZeros() <= kMaxCorners,
+              "surface consensus similarity", "a sample is blended from at most 3 corners");
       for (SampleWeights::InnerIterator it(samples.weights, members[j]); it; ++it) {
         unknowns.push_back(static_cast<int>(it.col()));
       }
@@ -244,8 +250,8 @@ double SurfaceConsensusSimilarity::PlainModelOfBlock(int block, const Eigen::Vec
   const auto sz = [&](int i) { return &per_unknown[(3 * i + 2) * channels]; };
   gradient->setZero(p);
   Eigen::MatrixXd own = Eigen::MatrixXd::Zero(p, p), across = Eigen::MatrixXd::Zero(p, p);
-  int local[3];
-  double weights[3];
+  int local[kMaxCorners];
+  double weights[kMaxCorners];
   double e[3];
   for (int j = 0; j < n; ++j) {
     int corners = 0;
