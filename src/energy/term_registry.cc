@@ -58,14 +58,14 @@ std::vector<std::unique_ptr<DataTerm>> SampledTerms(const DataTermContext& conte
   auto patches =
       std::make_unique<PixelConsensusSimilarity>(context.samples, context.sample_cameras, options);
   patches->SmoothShapesOver(&context.neighbours);
+  // The surface term reads through the patches; both live as long as the energy.
+  const PixelConsensusSimilarity& read_through = *patches;
   std::vector<std::unique_ptr<DataTerm>> terms;
+  terms.push_back(std::move(patches));
   if (options.surface_weight > 0.0) {
     terms.push_back(
-        std::make_unique<SurfaceConsensusSimilarity>(*patches, context.samples, options));
+        std::make_unique<SurfaceConsensusSimilarity>(read_through, context.samples, options));
   }
-  // The patches first, as the energy sums its terms; the surface term reads through them, and
-  // both live as long as the energy.
-  terms.insert(terms.begin(), std::move(patches));
   return terms;
 }
 

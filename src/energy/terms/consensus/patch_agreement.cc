@@ -224,12 +224,11 @@ void PatchAgreementTerm::PlainResiduals(int b, double k, double* residuals,
   // The colours become the residuals in place.
   PatchColors(b, k, residuals, jacobian);
   internal::AgreementResiduals(PatchSize(b), NumCameras(b), options_.contrast_floor,
-                               !options_.gain_per_channel, scale_ * weights_[b], residuals,
-                               jacobian);
+                               !options_.gain_per_channel, ResidualWeight(b), residuals, jacobian);
 }
 
 double PatchAgreementTerm::LossScale(int b) const {
-  return internal::AgreementLossScale(PatchSize(b), NumCameras(b), scale_ * weights_[b],
+  return internal::AgreementLossScale(PatchSize(b), NumCameras(b), ResidualWeight(b),
                                       options_.robust_fraction);
 }
 

@@ -285,7 +285,8 @@ void PixelConsensusSimilarity::ReadPatch(int b, const double* member_k, double* 
     const long row_step = RowStep(image);
     for (int m = 0; m < n; ++m) {
       double x, y, dx, dy;
-      const SampleRay ray = rays != nullptr ? rays[m] : RayOf(c, members[m]);
+      SampleRay projected;
+      const SampleRay& ray = rays != nullptr ? rays[m] : (projected = RayOf(c, members[m]));
       PixelOnRay(ray.at_zero, ray.direction, member_k[m], &x, &y, &dx, &dy);
       cells[m] = CellAt(image, x, y, dx, dy);
       __builtin_prefetch(cells[m].top);

@@ -109,6 +109,18 @@ Eigen::VectorXd SurfaceConsensusSimilarity::Gather(const std::vector<double>& pe
   return sums;
 }
 
+int SurfaceConsensusSimilarity::CornersOf(int block, int sample, int* local,
+                                          double* weights) const {
+  const std::vector<int>& unknowns = blocks_[block].parameters;
+  int corners = 0;
+  for (SampleWeights::InnerIterator it(samples_.weights, sample); it; ++it, ++corners) {
+    local[corners] = static_cast<int>(std::lower_bound(unknowns.begin(), unknowns.end(), it.col()) -
+                                      unknowns.begin());
+    weights[corners] = it.value();
+  }
+  return corners;
+}
+
 void SurfaceConsensusSimilarity::ReadNormalised(int block, const Eigen::VectorXd& k,
                                                 std::vector<double>* z,
                                                 std::vector<double>* derivatives,
@@ -152,14 +164,15 @@ void SurfaceConsensusSimilarity::PlainResidualsOfBlock(int block, const Eigen::V
   // weight on v; each corner's column then goes through the normalisation as one direction of k.
   const int p = static_cast<int>(unknowns.size());
   jacobian->setZero(m, p);
+  int local[kMaxCorners];
+  double weights[kMaxCorners];
   for (int j = 0; j < n; ++j) {
-    for (SampleWeights::InnerIterator it(samples_.weights, members[j]); it; ++it) {
-      const int i = static_cast<int>(std::lower_bound(unknowns.begin(), unknowns.end(), it.col()) -
-                                     unknowns.begin());
+    const int corners = CornersOf(block, members[j], local, weights);
+    for (int q = 0; q < corners; ++q) {
       for (int a = 0; a < num_cameras; ++a) {
         for (int channel = 0; channel < 3; ++channel) {
           const int r = stride * a + 3 * j + channel;
-          (*jacobian)(r, i) = it.value() * derivatives[r];
+          (*jacobian)(r, local[q]) = weights[q] * derivatives[r];
         }
       }
     }
@@ -254,12 +267,7 @@ double SurfaceConsensusSimilarity::PlainModelOfBlock(int block, const Eigen::Vec
   double weights[kMaxCorners];
   double e[3];
   for (int j = 0; j < n; ++j) {
-    int corners = 0;
-    for (SampleWeights::InnerIterator it(samples_.weights, members[j]); it; ++it, ++corners) {
-      local[corners] = static_cast<int>(
-          std::lower_bound(unknowns.begin(), unknowns.end(), it.col()) - unknowns.begin());
-      weights[corners] = it.value();
-    }
+    const int corners = CornersOf(block, members[j], local, weights);
     double own_scale = 0.0, gradient_scale = 0.0;
     for (int c = 0; c < 3; ++c) e[c] = 0.0;
     for (int a = 0; a < num_cameras; ++a) {
@@ -309,7 +317,7 @@ double SurfaceConsensusSimilarity::PlainModelOfBlock(int block, const Eigen::Vec
       for (int a = 0; a < num_cameras; ++a) u_hat(i, c) += u(i, 3 * a + c);
     }
   }
-  Eigen::VectorXd w2_channels(channels), s_rho_weight(channels), own_gram(channels);
+  Eigen::VectorXd w2_channels(channels), own_gram(channels);
   for (int a = 0; a < num_cameras; ++a) {
     for (int c = 0; c < 3; ++c) {
       w2_channels[3 * a + c] = w2[c];

@@ -64,6 +64,9 @@ class SurfaceConsensusSimilarity : public DataTerm {
                         Eigen::MatrixXd* jacobian) const;
 
  private:
+  // The corners `sample` of block `block` is blended from, as indices into the block's unknowns
+  // (`local`), and its weights on them; returns how many (at most 3).
+  int CornersOf(int block, int sample, int* local, double* weights) const;
   // Block b's colours with every sample where the mesh displaced by k puts it, normalised per
   // camera (`z`; the inverse deviations, 3 a camera, in `inverse_deviations`) and, when
   // `derivatives` is not null, the colours' derivatives in their own sample's displacement.
