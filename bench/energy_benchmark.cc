@@ -150,12 +150,14 @@ BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond
 
 // The detail stage's second term (energy.consensus.surface_weight: the refined mesh itself, each
 // sample moved with its face's corners): its reduced rows with their Jacobians where the stage
-// starts, as BM_DetailBlockSummaries.
+// starts, as BM_DetailBlockSummaries; through the patches that cover the faces (the default) or,
+// with a second argument of 1, through every patch.
 void BM_DetailSurfaceRows(benchmark::State& state) {
   const SkirtFrame& skirt = Skirt();
   const int threads = state.range(0) > 0 ? static_cast<int>(state.range(0)) : omp_get_num_procs();
   RefineOptions options;
   options.energy.consensus.surface_weight = 1.0;
+  if (state.range(1) == 1) options.energy.consensus.surface_patches = SurfacePatches::kAll;
   PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
   PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
@@ -166,7 +168,11 @@ void BM_DetailSurfaceRows(benchmark::State& state) {
   state.counters["threads"] = threads;
   state.counters["blocks"] = static_cast<double>(surface.residual_blocks().size());
 }
-BENCHMARK(BM_DetailSurfaceRows)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DetailSurfaceRows)
+    ->Args({1, 0})
+    ->Args({0, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond);
 
 // One solve of a prepared frame with Ceres and the linear solver named, from the plane sweep's
 // start, as the first of a frame's passes: the solver's own work around the evaluations, beside

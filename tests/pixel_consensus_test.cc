@@ -429,14 +429,16 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
 // The second term of the detail stage (surface_consensus_similarity.h): the same patches read
 // with every sample where the blend of its face's corners puts it.
 struct SurfaceTermScene {
-  explicit SurfaceTermScene(double truth_offset, double weight = 1.0, bool pooled_gain = false)
+  explicit SurfaceTermScene(double truth_offset, double weight = 1.0, bool pooled_gain = false,
+                            SurfacePatches through = SurfacePatches::kFaceCover)
       : scene(MakeSampledScene(truth_offset)),
-        options(Weighted(weight, pooled_gain)),
+        options(Weighted(weight, pooled_gain, through)),
         patches(scene.samples, scene.cameras, options),
         surface(patches, scene.samples, options) {}
-  static ConsensusOptions Weighted(double weight, bool pooled_gain) {
+  static ConsensusOptions Weighted(double weight, bool pooled_gain, SurfacePatches through) {
     ConsensusOptions options = SampledOptions().consensus;
     options.surface_weight = weight;
+    options.surface_patches = through;
     options.gain_per_channel = !pooled_gain;
     return options;
   }
@@ -466,15 +468,20 @@ TEST(SurfaceConsensusTest, TheDetailStageSumsItWithThePatchesWhenItHasAWeight) {
 }
 
 // A block depends on its vertex and the corners of its faces: every unknown a sample of the
-// patch is blended from, and those only.
-TEST(SurfaceConsensusTest, ABlockDependsOnTheCornersOfItsSamples) {
-  const SurfaceTermScene t(0.001);
+// patch is blended from, and those only; with every patch or with a set that covers the faces.
+class SurfaceBlocksTest : public testing::TestWithParam<SurfacePatches> {};
+
+TEST_P(SurfaceBlocksTest, ABlockDependsOnTheCornersOfItsSamples) {
+  const SurfaceTermScene t(0.001, 1.0, false, GetParam());
   const auto& blocks = t.surface.residual_blocks();
-  ASSERT_EQ(blocks.size(), t.patches.residual_blocks().size());
+  if (GetParam() == SurfacePatches::kAll) {
+    ASSERT_EQ(blocks.size(), t.patches.residual_blocks().size());
+  }
   for (size_t b = 0; b < blocks.size(); ++b) {
+    const int patch = t.surface.PatchOf(static_cast<int>(b));
     std::vector<int> corners;
-    const int* members = t.patches.Members(static_cast<int>(b));
-    for (int j = 0; j < t.patches.PatchSize(static_cast<int>(b)); ++j) {
+    const int* members = t.patches.Members(patch);
+    for (int j = 0; j < t.patches.PatchSize(patch); ++j) {
       for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(t.scene.samples.weights,
                                                                           members[j]);
            it; ++it) {
@@ -487,9 +494,64 @@ TEST(SurfaceConsensusTest, ABlockDependsOnTheCornersOfItsSamples) {
     EXPECT_EQ(blocks[b].num_residuals, static_cast<int>(corners.size()) + 1);
     // The patch's own vertex is one of them.
     EXPECT_TRUE(std::binary_search(corners.begin(), corners.end(),
-                                   t.patches.residual_blocks()[b].parameters[0]));
+                                   t.patches.residual_blocks()[patch].parameters[0]));
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, SurfaceBlocksTest,
+                         testing::Values(SurfacePatches::kFaceCover, SurfacePatches::kAll),
+                         [](const testing::TestParamInfo<SurfacePatches>& info) {
+                           return info.param == SurfacePatches::kAll ? "All" : "FaceCover";
+                         });
+
+// The covering set compares every sample between vertices that a patch holds through a patch,
+// each patch once: with samples inside the faces (two levels) one corner of each face, about a
+// third of the patches on a regular grid; with the faces split once, where the edges' midpoints
+// are the only samples between vertices, one end of each edge, about two thirds.
+class FaceCoverTest : public testing::TestWithParam<int> {};
+
+TEST_P(FaceCoverTest, ComparesEverySampleBetweenVerticesInAFewPatches) {
+  const int levels = GetParam();
+  const SampledScene scene = MakeSampledScene(0.001, levels);
+  const ConsensusOptions options =
+      SurfaceTermScene::Weighted(1.0, false, SurfacePatches::kFaceCover);
+  const PixelConsensusSimilarity patches(scene.samples, scene.cameras, options);
+  const SurfaceConsensusSimilarity surface(patches, scene.samples, options);
+  const int num_patches = static_cast<int>(patches.residual_blocks().size());
+  const int num_blocks = static_cast<int>(surface.residual_blocks().size());
+  const int between = levels == 1 ? 2 : 3;
+  std::vector<char> in_a_patch(scene.samples.size(), 0), compared(in_a_patch.size(), 0);
+  for (int b = 0; b < num_patches; ++b) {
+    for (int j = 0; j < patches.PatchSize(b); ++j) in_a_patch[patches.Members(b)[j]] = 1;
+  }
+  for (int b = 0; b < num_blocks; ++b) {
+    const int patch = surface.PatchOf(b);
+    if (b > 0) {
+      EXPECT_GT(patch, surface.PatchOf(b - 1));  // Each once, in the patches' order.
+    }
+    for (int j = 0; j < patches.PatchSize(patch); ++j) compared[patches.Members(patch)[j]] = 1;
+  }
+  int checked = 0;
+  for (int j = 0; j < scene.samples.size(); ++j) {
+    if (in_a_patch[j] == 0 || scene.samples.weights.row(j).nonZeros() != between) continue;
+    ++checked;
+    EXPECT_EQ(compared[j], 1) << "sample " << j;
+  }
+  EXPECT_GT(checked, 50);
+  const double share = static_cast<double>(num_blocks) / num_patches;
+  if (levels == 1) {
+    EXPECT_GT(share, 0.55);
+    EXPECT_LT(share, 0.8);
+  } else {
+    EXPECT_GT(share, 0.25);
+    EXPECT_LT(share, 0.45);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, FaceCoverTest, testing::Values(1, 2),
+                         [](const testing::TestParamInfo<int>& info) {
+                           return info.param == 1 ? "EdgesOnly" : "InsideTheFaces";
+                         });
 
 TEST(SurfaceConsensusTest, GradientMatchesCentralDifferences) {
   const SurfaceTermScene t(0.0015);
@@ -590,9 +652,10 @@ TEST(SurfaceConsensusTest, WithEveryKTheSameItIsThePatchTermTimesItsWeight) {
   std::vector<double> patch_costs, surface_costs;
   t.patches.BlockCosts(k, &patch_costs);
   t.surface.BlockCosts(k, &surface_costs);
-  ASSERT_EQ(patch_costs.size(), surface_costs.size());
-  for (size_t b = 0; b < patch_costs.size(); ++b) {
-    EXPECT_NEAR(surface_costs[b], 3.0 * patch_costs[b], 1e-9 * std::max(patch_costs[b], 1e-12))
+  ASSERT_FALSE(surface_costs.empty());
+  for (size_t b = 0; b < surface_costs.size(); ++b) {
+    const double patch_cost = patch_costs[t.surface.PatchOf(static_cast<int>(b))];
+    EXPECT_NEAR(surface_costs[b], 3.0 * patch_cost, 1e-9 * std::max(patch_cost, 1e-12))
         << "block " << b;
   }
 }

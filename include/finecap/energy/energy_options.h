@@ -20,6 +20,11 @@ const std::vector<EnumName<SimilarityType>>& EnumNames(SimilarityType);
 enum class RegUnit { kMillimetres, kMetres };
 const std::vector<EnumName<RegUnit>>& EnumNames(RegUnit);
 
+// Which patches the detail stage's second term compares the refined mesh through
+// (ConsensusOptions::surface_patches).
+enum class SurfacePatches { kFaceCover, kAll };
+const std::vector<EnumName<SurfacePatches>>& EnumNames(SurfacePatches);
+
 // Options of the consensus similarity (consensus_similarity.h). The fields are documented where
 // Fields() declares them (docs/configuration.md: energy.consensus); the comments below add what
 // the documentation does not say.
@@ -57,9 +62,12 @@ struct ConsensusOptions {
   // With samples: the weight of the detail stage's second term, which compares the refined mesh
   // itself (each sample where the blend of its face's corners' k puts it;
   // SurfaceConsensusSimilarity), beside the patches moved as wholes; 0: the patches alone. 1
-  // gains on every capture measured but takes 2 to 3 times a frame's time (docs/measurements.md,
-  // 2026-12-06), so it is off by default until it is cheaper.
+  // gains on every capture measured and makes level 2 beat level 1 on both real captures, but
+  // takes 1.6 times a frame's time (docs/measurements.md, 2026-12-06), so it is off by default.
   double surface_weight = 0.0;
+  // Every face lies in the patches of its three corners; kFaceCover compares it in one of them
+  // (SurfaceConsensusSimilarity).
+  SurfacePatches surface_patches = SurfacePatches::kFaceCover;
   // The surface's appearance is the same in every frame while its shape changes: with it on, the
   // colours the frame before's refined surface showed at each sample (averaged over the cameras
   // that saw it; SurfaceSamples::appearance) are one more view every patch is compared with, so

@@ -175,9 +175,11 @@ void Robustify(double c2, double* squared_norm, Eigen::VectorXd* gradient,
   const CauchyScaling scaling(c2, *squared_norm);
   const double alpha = scaling.alpha, s = *squared_norm;
   const Eigen::VectorXd dalpha_dk = scaling.dalpha_ds * 2.0 * *gradient;
-  const Eigen::MatrixXd cross = alpha * dalpha_dk * gradient->transpose();
-  *curvature = alpha * alpha * *curvature + cross + cross.transpose() +
-               s * dalpha_dk * dalpha_dk.transpose();
+  if (curvature != nullptr) {
+    const Eigen::MatrixXd cross = alpha * dalpha_dk * gradient->transpose();
+    *curvature = alpha * alpha * *curvature + cross + cross.transpose() +
+                 s * dalpha_dk * dalpha_dk.transpose();
+  }
   *gradient = alpha * alpha * *gradient + alpha * s * dalpha_dk;
   *squared_norm = alpha * alpha * s;
 }

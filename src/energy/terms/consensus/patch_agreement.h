@@ -58,7 +58,7 @@ void Robustify(double c2, int num_residuals, double* residuals, double* jacobian
 BlockSummary Robustify(double c2, const BlockSummary& plain, bool with_derivatives);
 
 // The same for a block of several unknowns, in place: its sum of squares s, gradient J^T r and
-// Gauss-Newton matrix J^T J after the loss, from those before it.
+// Gauss-Newton matrix J^T J (when `curvature` is not null) after the loss, from those before it.
 void Robustify(double c2, double* squared_norm, Eigen::VectorXd* gradient,
                Eigen::MatrixXd* curvature);
 

@@ -1,7 +1,11 @@
 #include "energy/terms/consensus/surface_consensus_similarity.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
 
 #include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
@@ -34,7 +38,8 @@ void ReducedRows(double s, const Eigen::VectorXd& g, Eigen::MatrixXd* h, double*
     return;
   }
   h->diagonal().array() += kRelativeRidge * largest;
-  const Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> factor(*h);
+  // Factored in place: no allocation per block.
+  const Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> factor(*h);
   Eigen::Map<Eigen::VectorXd> reducible(rows, p);
   reducible = factor.matrixL().solve(g);
   for (int i = 0; i < p; ++i) {
@@ -45,6 +50,273 @@ void ReducedRows(double s, const Eigen::VectorXd& g, Eigen::MatrixXd* h, double*
   std::fill_n(jacobian + p * p, p, 0.0);
 }
 
+// The corners every sample of patch `b` is blended from, ascending: the unknowns of its block.
+std::vector<int> CornersOfPatch(const PixelConsensusSimilarity& patches,
+                                const SurfaceSamples& samples, int b) {
+  std::vector<int> corners;
+  const int* members = patches.Members(b);
+  for (int j = 0; j < patches.PatchSize(b); ++j) {
+    Require(samples.weights.row(members[j]).nonZeros() <= kMaxCorners,
+            "surface consensus similarity", "a sample is blended from at most 3 corners");
+    for (SampleWeights::InnerIterator it(samples.weights, members[j]); it; ++it) {
+      corners.push_back(static_cast<int>(it.col()));
+    }
+  }
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  return corners;
+}
+
+// The most corners a member of a patch is blended from: 3 where the samples lie inside the faces,
+// 2 where the faces are split once (their edges' midpoints are the only samples between
+// vertices).
+int MostCorners(const PixelConsensusSimilarity& patches, const SurfaceSamples& samples) {
+  int most = 0;
+  for (int b = 0; b < static_cast<int>(patches.residual_blocks().size()); ++b) {
+    const int* members = patches.Members(b);
+    for (int j = 0; j < patches.PatchSize(b); ++j) {
+      most = std::max(most, static_cast<int>(samples.weights.row(members[j]).nonZeros()));
+    }
+  }
+  return most;
+}
+
+// The faces of the mesh the patches' samples lie on, as their corners (ascending), each once:
+// the triangles of the vertices that share a sample.
+std::vector<std::array<int, 3>> FacesOfPatches(const PixelConsensusSimilarity& patches,
+                                               const SurfaceSamples& samples) {
+  std::vector<std::vector<int>> adjacent(samples.weights.cols());
+  for (int b = 0; b < static_cast<int>(patches.residual_blocks().size()); ++b) {
+    const int* members = patches.Members(b);
+    for (int j = 0; j < patches.PatchSize(b); ++j) {
+      for (SampleWeights::InnerIterator it(samples.weights, members[j]); it; ++it) {
+        for (SampleWeights::InnerIterator other(samples.weights, members[j]); other; ++other) {
+          if (other.col() != it.col()) adjacent[it.col()].push_back(static_cast<int>(other.col()));
+        }
+      }
+    }
+  }
+  for (std::vector<int>& list : adjacent) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  std::vector<std::array<int, 3>> faces;
+  for (int v = 0; v < static_cast<int>(adjacent.size()); ++v) {
+    for (int a : adjacent[v]) {
+      if (a < v) continue;
+      for (int c : adjacent[v]) {
+        if (c > a && std::binary_search(adjacent[a].begin(), adjacent[a].end(), c)) {
+          faces.push_back({v, a, c});
+        }
+      }
+    }
+  }
+  return faces;
+}
+
+// Three colours for the vertices of `faces` such that the corners of a face differ wherever the
+// mesh allows it: from a face coloured 0, 1, 2, breadth-first over faces that share an edge, the
+// corner opposite a coloured edge takes the colour its two ends leave. That is a proper colouring
+// of a mesh whose vertices all have an even number of faces (a regular one, and Loop's
+// subdivisions away from the input's own vertices); around the others some faces get two corners
+// of one colour. -1 for vertices on no face.
+std::vector<int> ColourVertices(const std::vector<std::array<int, 3>>& faces, int num_vertices) {
+  // Each face's edges, sorted by their ends, so that the faces around an edge are adjacent.
+  std::vector<std::pair<std::pair<int, int>, int>> edges;
+  for (int f = 0; f < static_cast<int>(faces.size()); ++f) {
+    const std::array<int, 3>& v = faces[f];
+    edges.push_back({{v[0], v[1]}, f});
+    edges.push_back({{v[0], v[2]}, f});
+    edges.push_back({{v[1], v[2]}, f});
+  }
+  std::sort(edges.begin(), edges.end());
+  std::vector<std::vector<int>> neighbours(faces.size());
+  for (size_t begin = 0, end = 0; begin < edges.size(); begin = end) {
+    while (end < edges.size() && edges[end].first == edges[begin].first) ++end;
+    for (size_t a = begin; a < end; ++a) {
+      for (size_t b = begin; b < end; ++b) {
+        if (a != b) neighbours[edges[a].second].push_back(edges[b].second);
+      }
+    }
+  }
+  std::vector<int> colour(num_vertices, -1);
+  std::vector<char> queued(faces.size(), 0);
+  std::vector<int> queue;
+  for (int seed = 0; seed < static_cast<int>(faces.size()); ++seed) {
+    if (queued[seed] != 0) continue;
+    queued[seed] = 1;
+    queue.assign(1, seed);
+    for (size_t head = 0; head < queue.size(); ++head) {
+      const std::array<int, 3>& v = faces[queue[head]];
+      bool used[3] = {false, false, false};
+      for (int corner : v) {
+        if (colour[corner] >= 0) used[colour[corner]] = true;
+      }
+      for (int corner : v) {
+        if (colour[corner] >= 0) continue;
+        const int left = static_cast<int>(std::find(used, used + 3, false) - used);
+        colour[corner] = left < 3 ? left : 0;
+        if (left < 3) used[left] = true;
+      }
+      for (int next : neighbours[queue[head]]) {
+        if (queued[next] == 0) {
+          queued[next] = 1;
+          queue.push_back(next);
+        }
+      }
+    }
+  }
+  return colour;
+}
+
+// The patches through which the term compares every sample between the vertices once, ascending.
+// Every patch holds all the faces of its vertex, so that each face is compared in the patches of
+// its three corners; comparing it in one compares the same pixels, and costs a third (on
+// synth_skirt a third of the patches keep most of what the term gains, docs/measurements.md,
+// 2026-12-06). With samples inside the faces: the patches of one colour of ColourVertices, which
+// has a corner on every face of a regular mesh; with the faces split once, whose only samples
+// between vertices are the edges' midpoints: two colours, an end of every edge. Then the patches
+// that hold a sample between vertices that none of them holds (irregular vertices, a mask's
+// cut), in order; of the three choices of colours, the one with the fewest patches.
+std::vector<int> FaceCoveringPatches(const PixelConsensusSimilarity& patches,
+                                     const SurfaceSamples& samples) {
+  const int num_patches = static_cast<int>(patches.residual_blocks().size());
+  const std::vector<int> vertex_colour =
+      ColourVertices(FacesOfPatches(patches, samples), samples.weights.cols());
+  const int between = MostCorners(patches, samples);
+  std::vector<char> covered;
+  const auto cover = [&](int b) {
+    const int* members = patches.Members(b);
+    for (int j = 0; j < patches.PatchSize(b); ++j) covered[members[j]] = 1;
+  };
+  const auto leaves_one_out = [&](int b) {
+    const int* members = patches.Members(b);
+    for (int j = 0; j < patches.PatchSize(b); ++j) {
+      if (covered[members[j]] == 0 && samples.weights.row(members[j]).nonZeros() == between) {
+        return true;
+      }
+    }
+    return false;
+  };
+  // The patches of the colours in `colours` (a bit each), and those that hold a sample between
+  // vertices that none of them holds.
+  const auto cover_from = [&](int colours) {
+    covered.assign(samples.size(), 0);
+    std::vector<char> taken(num_patches, 0);
+    for (int b = 0; b < num_patches; ++b) {
+      const int colour = vertex_colour[patches.residual_blocks()[b].parameters[0]];
+      if (colour >= 0 && (colours >> colour & 1) != 0) {
+        taken[b] = 1;
+        cover(b);
+      }
+    }
+    std::vector<int> chosen;
+    for (int b = 0; b < num_patches; ++b) {
+      if (taken[b] == 0 && leaves_one_out(b)) {
+        taken[b] = 1;
+        cover(b);
+      }
+      if (taken[b] != 0) chosen.push_back(b);
+    }
+    return chosen;
+  };
+  // With samples inside the faces one colour has a corner on each; with samples on the edges
+  // only, two colours have an end on each edge.
+  const std::vector<int> candidates =
+      between == kMaxCorners ? std::vector<int>{1, 2, 4} : std::vector<int>{3, 5, 6};
+  std::vector<int> best;
+  for (size_t c = 0; c < candidates.size(); ++c) {
+    std::vector<int> chosen = cover_from(candidates[c]);
+    if (c == 0 || chosen.size() < best.size()) best = std::move(chosen);
+  }
+  return best;
+}
+
+// A block's sums over its members in PlainModelOfBlock (whose notation this follows), member
+// after member: the inputs, each member's rows of K = 3 C entries, and the sums they add to.
+struct MemberSums {
+  int n, p;
+  bool with_curvature;
+  double squared_norm = 0.0;
+  const double *s, *w2, *z, *d;
+  // Each member's kMaxCorners corners (indices into the block's unknowns) and weights.
+  const uint16_t* local;
+  const double* corner_weights;
+  // zy (K), the Gram matrices (C x C x 3, upper half), the rows per unknown (rho, mu, sigma; rho
+  // alone without the curvature), g (p), own and across (p x p).
+  double *zy, *gram, *per_unknown, *gradient, *own, *across;
+};
+
+// The sums of a block seen by kCameras cameras (0: num_cameras, not known when compiled): with
+// the count a constant, the loops over a member's entries are unrolled and vectorised, and the
+// channel of an entry is known without a division.
+template <int kCameras>
+void SumMembers(int num_cameras, MemberSums* sums) {
+  const int cameras = kCameras > 0 ? kCameras : num_cameras;
+  const int K = 3 * cameras, stride = (sums->with_curvature ? 3 : 1) * K, p = sums->p;
+  const double* s = sums->s;
+  const double* w2 = sums->w2;
+  double row[3 * 3 * (kCameras > 0 ? kCameras : 1)];
+  thread_local std::vector<double> dynamic_row;
+  if (kCameras == 0) dynamic_row.resize(3 * K);
+  double* member_row = kCameras > 0 ? row : dynamic_row.data();
+  double squared_norm = 0.0;
+  for (int j = 0; j < sums->n; ++j) {
+    const double* zj = sums->z + j * K;
+    const double* dj = sums->d + j * K;
+    double mean[3] = {0.0, 0.0, 0.0}, e[3] = {0.0, 0.0, 0.0};
+    for (int a = 0; a < cameras; ++a) {
+      for (int c = 0; c < 3; ++c) {
+        mean[c] += zj[3 * a + c];
+        e[c] += s[3 * a + c] * dj[3 * a + c];
+      }
+    }
+    double own_scale = 0.0, gradient_scale = 0.0;
+    for (int a = 0; a < cameras; ++a) {
+      for (int c = 0; c < 3; ++c) {
+        const int t = 3 * a + c;
+        const double y = zj[t] - mean[c] / cameras, sd = s[t] * dj[t];
+        squared_norm += w2[t] * y * y;
+        sums->zy[t] += zj[t] * y;
+        own_scale += w2[t] * sd * sd;
+        gradient_scale += w2[t] * sd * y;
+        member_row[t] = zj[t] * dj[t];
+        if (sums->with_curvature) {
+          member_row[K + t] = dj[t];
+          member_row[2 * K + t] = e[c] * zj[t];
+        }
+      }
+    }
+    if (sums->with_curvature) {
+      for (int a = 0; a < cameras; ++a) {
+        for (int b = a; b < cameras; ++b) {
+          for (int c = 0; c < 3; ++c) {
+            sums->gram[(a * cameras + b) * 3 + c] += zj[3 * a + c] * zj[3 * b + c];
+          }
+        }
+      }
+    }
+    const uint16_t* local = sums->local + kMaxCorners * j;
+    const double* weights = sums->corner_weights + kMaxCorners * j;
+    for (int q = 0; q < kMaxCorners; ++q) {
+      const double wi = weights[q];
+      sums->gradient[local[q]] += wi * gradient_scale;
+      double* unknown_rows = sums->per_unknown + static_cast<size_t>(local[q]) * stride;
+      for (int t = 0; t < stride; ++t) unknown_rows[t] += wi * member_row[t];
+    }
+    if (!sums->with_curvature) continue;
+    const double across_scale = w2[0] * e[0] * e[0] + w2[1] * e[1] * e[1] + w2[2] * e[2] * e[2];
+    for (int q = 0; q < kMaxCorners; ++q) {
+      for (int r = 0; r < kMaxCorners; ++r) {
+        const double ww = weights[q] * weights[r];
+        sums->own[local[q] * p + local[r]] += ww * own_scale;
+        sums->across[local[q] * p + local[r]] += ww * across_scale;
+      }
+    }
+  }
+  sums->squared_norm = squared_norm;
+}
+
 }  // namespace
 
 SurfaceConsensusSimilarity::SurfaceConsensusSimilarity(const PixelConsensusSimilarity& patches,
@@ -52,27 +324,25 @@ SurfaceConsensusSimilarity::SurfaceConsensusSimilarity(const PixelConsensusSimil
                                                        const ConsensusOptions& options)
     : patches_(patches), samples_(samples), options_(options) {
   options_.Check();
+  const int num_patches = static_cast<int>(patches.residual_blocks().size());
+  std::vector<std::vector<int>> unknowns(num_patches);
+  for (int b = 0; b < num_patches; ++b) unknowns[b] = CornersOfPatch(patches, samples, b);
+  if (options_.surface_patches == SurfacePatches::kFaceCover) {
+    patch_of_ = FaceCoveringPatches(patches, samples);
+  } else {
+    patch_of_.resize(num_patches);
+    std::iota(patch_of_.begin(), patch_of_.end(), 0);
+  }
   row_begin_.assign(1, 0);
   jacobian_begin_.assign(1, 0);
-  for (int b = 0; b < static_cast<int>(patches.residual_blocks().size()); ++b) {
-    // The block's unknowns: every corner a sample of its patch is blended from.
-    std::vector<int> unknowns;
-    const int* members = patches.Members(b);
-    for (int j = 0; j < patches.PatchSize(b); ++j) {
-      Require(samples.weights.row(members[j]).nonZeros() <= kMaxCorners,
-              "surface consensus similarity", "a sample is blended from at most 3 corners");
-      for (SampleWeights::InnerIterator it(samples.weights, members[j]); it; ++it) {
-        unknowns.push_back(static_cast<int>(it.col()));
-      }
-    }
-    std::sort(unknowns.begin(), unknowns.end());
-    unknowns.erase(std::unique(unknowns.begin(), unknowns.end()), unknowns.end());
-    const int p = static_cast<int>(unknowns.size());
-    blocks_.push_back({std::move(unknowns), p + 1});
+  for (int patch : patch_of_) {
+    const int p = static_cast<int>(unknowns[patch].size());
+    blocks_.push_back({std::move(unknowns[patch]), p + 1});
     row_begin_.push_back(row_begin_.back() + p + 1);
     jacobian_begin_.push_back(jacobian_begin_.back() + static_cast<long>(p + 1) * p);
   }
   IndexContributions(samples.weights.cols());
+  TabulateCorners();
 }
 
 void SurfaceConsensusSimilarity::IndexContributions(int num_unknowns) {
@@ -109,35 +379,60 @@ Eigen::VectorXd SurfaceConsensusSimilarity::Gather(const std::vector<double>& pe
   return sums;
 }
 
-int SurfaceConsensusSimilarity::CornersOf(int block, int sample, int* local,
-                                          double* weights) const {
-  const std::vector<int>& unknowns = blocks_[block].parameters;
-  int corners = 0;
-  for (SampleWeights::InnerIterator it(samples_.weights, sample); it; ++it, ++corners) {
-    local[corners] = static_cast<int>(std::lower_bound(unknowns.begin(), unknowns.end(), it.col()) -
-                                      unknowns.begin());
-    weights[corners] = it.value();
+void SurfaceConsensusSimilarity::CornersOfMembers(int block, MemberCorners* corners) const {
+  const int n = patches_.PatchSize(patch_of_[block]);
+  const int* members = patches_.Members(patch_of_[block]);
+  const uint16_t* local = &corner_local_[member_begin_[block] * kMaxCorners];
+  corners->local.assign(local, local + n * kMaxCorners);
+  corners->weights.assign(corners->local.size(), 0.0);
+  for (int j = 0; j < n; ++j) {
+    int corner = kMaxCorners * j;
+    for (SampleWeights::InnerIterator it(samples_.weights, members[j]); it; ++it, ++corner) {
+      corners->weights[corner] = it.value();
+    }
   }
-  return corners;
+}
+
+void SurfaceConsensusSimilarity::TabulateCorners() {
+  member_begin_.assign(1, 0);
+  for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) {
+    member_begin_.push_back(member_begin_.back() + patches_.PatchSize(patch_of_[b]));
+  }
+  corner_local_.assign(member_begin_.back() * kMaxCorners, 0);
+  for (int b = 0; b < static_cast<int>(blocks_.size()); ++b) {
+    const std::vector<int>& unknowns = blocks_[b].parameters;
+    Require(unknowns.size() <= std::numeric_limits<uint16_t>::max(), "surface consensus similarity",
+            "a vertex on more than 65535 faces");
+    const int* members = patches_.Members(patch_of_[b]);
+    for (int j = 0; j < patches_.PatchSize(patch_of_[b]); ++j) {
+      long corner = (member_begin_[b] + j) * kMaxCorners;
+      for (SampleWeights::InnerIterator it(samples_.weights, members[j]); it; ++it, ++corner) {
+        corner_local_[corner] = static_cast<uint16_t>(
+            std::lower_bound(unknowns.begin(), unknowns.end(), it.col()) - unknowns.begin());
+      }
+    }
+  }
 }
 
 void SurfaceConsensusSimilarity::ReadNormalised(int block, const Eigen::VectorXd& k,
+                                                const MemberCorners& corners,
                                                 std::vector<double>* z,
                                                 std::vector<double>* derivatives,
                                                 std::vector<double>* inverse_deviations) const {
-  const int n = patches_.PatchSize(block), num_cameras = patches_.NumCameras(block);
-  const int* members = patches_.Members(block);
+  const int n = patches_.PatchSize(patch_of_[block]),
+            num_cameras = patches_.NumCameras(patch_of_[block]);
+  const std::vector<int>& unknowns = blocks_[block].parameters;
   thread_local std::vector<double> member_k;
   member_k.assign(n, 0.0);
   for (int j = 0; j < n; ++j) {
-    for (SampleWeights::InnerIterator it(samples_.weights, members[j]); it; ++it) {
-      member_k[j] += it.value() * k[it.col()];
+    for (int corner = kMaxCorners * j; corner < kMaxCorners * (j + 1); ++corner) {
+      member_k[j] += corners.weights[corner] * k[unknowns[corners.local[corner]]];
     }
   }
   const int stride = 3 * n;
   z->resize(static_cast<size_t>(stride) * num_cameras);
   if (derivatives != nullptr) derivatives->resize(z->size());
-  patches_.ReadPatch(block, member_k.data(), z->data(),
+  patches_.ReadPatch(patch_of_[block], member_k.data(), z->data(),
                      derivatives != nullptr ? derivatives->data() : nullptr);
   inverse_deviations->resize(3 * num_cameras);
   for (int a = 0; a < num_cameras; ++a) {
@@ -149,14 +444,17 @@ void SurfaceConsensusSimilarity::ReadNormalised(int block, const Eigen::VectorXd
 void SurfaceConsensusSimilarity::PlainResidualsOfBlock(int block, const Eigen::VectorXd& k,
                                                        Eigen::VectorXd* residuals,
                                                        Eigen::MatrixXd* jacobian) const {
-  const int n = patches_.PatchSize(block), num_cameras = patches_.NumCameras(block);
-  const int* members = patches_.Members(block);
+  const int n = patches_.PatchSize(patch_of_[block]),
+            num_cameras = patches_.NumCameras(patch_of_[block]);
   const std::vector<int>& unknowns = blocks_[block].parameters;
   const int m = 3 * n * num_cameras, stride = 3 * n;
   thread_local std::vector<double> derivatives, z, inverse_deviations;
-  ReadNormalised(block, k, &z, jacobian != nullptr ? &derivatives : nullptr, &inverse_deviations);
+  thread_local MemberCorners corners;
+  CornersOfMembers(block, &corners);
+  ReadNormalised(block, k, corners, &z, jacobian != nullptr ? &derivatives : nullptr,
+                 &inverse_deviations);
   const bool pooled = !options_.gain_per_channel;
-  const Eigen::Vector3d weight = patches_.ResidualWeight(block);
+  const Eigen::Vector3d weight = patches_.ResidualWeight(patch_of_[block]);
   *residuals = Eigen::Map<const Eigen::VectorXd>(z.data(), m);
   internal::AgainstCameraMean(n, num_cameras, weight, residuals->data());
   if (jacobian == nullptr) return;
@@ -164,15 +462,12 @@ void SurfaceConsensusSimilarity::PlainResidualsOfBlock(int block, const Eigen::V
   // weight on v; each corner's column then goes through the normalisation as one direction of k.
   const int p = static_cast<int>(unknowns.size());
   jacobian->setZero(m, p);
-  int local[kMaxCorners];
-  double weights[kMaxCorners];
   for (int j = 0; j < n; ++j) {
-    const int corners = CornersOf(block, members[j], local, weights);
-    for (int q = 0; q < corners; ++q) {
+    for (int corner = kMaxCorners * j; corner < kMaxCorners * (j + 1); ++corner) {
       for (int a = 0; a < num_cameras; ++a) {
         for (int channel = 0; channel < 3; ++channel) {
           const int r = stride * a + 3 * j + channel;
-          (*jacobian)(r, local[q]) = weights[q] * derivatives[r];
+          (*jacobian)(r, corners.local[corner]) += corners.weights[corner] * derivatives[r];
         }
       }
     }
@@ -191,7 +486,7 @@ void SurfaceConsensusSimilarity::ResidualsOfBlock(int block, const Eigen::Vector
                                                   Eigen::VectorXd* residuals,
                                                   Eigen::MatrixXd* jacobian) const {
   PlainResidualsOfBlock(block, k, residuals, jacobian);
-  const double c2 = patches_.LossScale(block);
+  const double c2 = patches_.LossScale(patch_of_[block]);
   const int m = static_cast<int>(residuals->size());
   const double root_weight = std::sqrt(options_.surface_weight);
   if (jacobian != nullptr) {
@@ -211,156 +506,159 @@ double SurfaceConsensusSimilarity::PlainModelOfBlock(int block, const Eigen::Vec
   // Notation of the derivation (docs/method.md, "The refined mesh itself"): camera a of the
   // block's C, member m of its n, channel c; z the normalised colours, s_ac their inverse
   // deviations, d the colours' derivatives in their own sample's displacement, W_mi the weight of
-  // member m on unknown i, w_c the residuals' weight, y = z - (the cameras' mean of z).
-  const int n = patches_.PatchSize(block), num_cameras = patches_.NumCameras(block);
-  const int* members = patches_.Members(block);
-  const std::vector<int>& unknowns = blocks_[block].parameters;
-  const int p = static_cast<int>(unknowns.size()), channels = 3 * num_cameras;
-  const int stride = 3 * n;
-  thread_local std::vector<double> z, d, inverse_deviations, mean_z, per_unknown, gram;
-  ReadNormalised(block, k, &z, &d, &inverse_deviations);
-  const bool pooled = !options_.gain_per_channel;
-  const Eigen::Vector3d weight = patches_.ResidualWeight(block);
-  const Eigen::Vector3d w2 = weight.cwiseAbs2();
-  const auto at = [&](int a, int j, int c) { return stride * a + 3 * j + c; };
-  const auto s_of = [&](int a, int c) { return inverse_deviations[3 * a + c]; };
-
-  // The cameras' mean of z, the cost, and per camera and channel the sum of z y.
-  mean_z.assign(stride, 0.0);
-  for (int a = 0; a < num_cameras; ++a) {
-    for (int t = 0; t < stride; ++t) mean_z[t] += z[stride * a + t];
-  }
-  for (double& value : mean_z) value /= num_cameras;
-  double squared_norm = 0.0;
-  Eigen::VectorXd zy = Eigen::VectorXd::Zero(channels);
+  // member m on unknown i, w_c the residuals' weight, y = z - (the cameras' mean of z). A
+  // channel of a camera is one of K = 3 C "entries" (index 3 a + c); every per-member and
+  // per-unknown quantity below is a row of K entries, so that the sums run over contiguous rows.
+  const int n = patches_.PatchSize(patch_of_[block]),
+            num_cameras = patches_.NumCameras(patch_of_[block]);
+  const int p = static_cast<int>(blocks_[block].parameters.size()), K = 3 * num_cameras;
+  const bool with_curvature = curvature != nullptr, pooled = !options_.gain_per_channel;
+  thread_local std::vector<double> camera_z, camera_d, s;
+  thread_local MemberCorners corners;
+  CornersOfMembers(block, &corners);
+  ReadNormalised(block, k, corners, &camera_z, &camera_d, &s);
+  // z, d and y member after member (ReadPatch writes them camera after camera); w2 and the
+  // cameras' Gram matrices of z per channel (gram[(a C + b) 3 + c] = sum_m z_amc z_bmc) per
+  // entry.
+  thread_local std::vector<double> z, d, w2, zy, gram;
+  z.resize(static_cast<size_t>(n) * K);
+  d.resize(z.size());
   for (int a = 0; a < num_cameras; ++a) {
     for (int j = 0; j < n; ++j) {
       for (int c = 0; c < 3; ++c) {
-        const double y = z[at(a, j, c)] - mean_z[3 * j + c];
-        squared_norm += w2[c] * y * y;
-        zy[3 * a + c] += z[at(a, j, c)] * y;
+        z[j * K + 3 * a + c] = camera_z[3 * (a * n + j) + c];
+        d[j * K + 3 * a + c] = camera_d[3 * (a * n + j) + c];
       }
     }
   }
-  // Gram of the cameras' z per channel: gram[(a * C + b) * 3 + c] = sum_m z_amc z_bmc.
-  gram.assign(static_cast<size_t>(num_cameras) * num_cameras * 3, 0.0);
-  for (int a = 0; a < num_cameras; ++a) {
-    for (int b = a; b < num_cameras; ++b) {
-      for (int c = 0; c < 3; ++c) {
-        double sum = 0.0;
-        for (int j = 0; j < n; ++j) sum += z[at(a, j, c)] * z[at(b, j, c)];
-        gram[(a * num_cameras + b) * 3 + c] = gram[(b * num_cameras + a) * 3 + c] = sum;
-      }
-    }
-  }
+  const Eigen::Vector3d weight = patches_.ResidualWeight(patch_of_[block]);
+  w2.resize(K);
+  for (int t = 0; t < K; ++t) w2[t] = weight[t % 3] * weight[t % 3];
+  zy.assign(K, 0.0);
+  gram.assign(with_curvature ? static_cast<size_t>(num_cameras) * num_cameras * 3 : 0, 0.0);
 
-  // Per unknown i, over its members: mu_iac = sum W d / n, rho_iac = sum W z d and
-  // sz_ibc = sum W E_mc z_bmc (E_mc = sum_a s_ac d_amc); the sparse parts of g and J^T J.
-  // per_unknown holds, for unknown i, mu, rho and sz of 3 C entries each.
-  per_unknown.assign(static_cast<size_t>(p) * 3 * channels, 0.0);
-  const auto mu = [&](int i) { return &per_unknown[(3 * i) * channels]; };
-  const auto rho = [&](int i) { return &per_unknown[(3 * i + 1) * channels]; };
-  const auto sz = [&](int i) { return &per_unknown[(3 * i + 2) * channels]; };
+  // Per unknown i, over its members, one row each of mu_i = sum W d, rho_i = sum W z d and
+  // sigma_i = sum W E_c z (E_mc = sum_a s_ac d_amc); with only the gradient asked, rho alone.
+  const int rows_per_unknown = with_curvature ? 3 : 1;
+  const int per_unknown_stride = rows_per_unknown * K;
+  thread_local std::vector<double> per_unknown;
+  per_unknown.assign(static_cast<size_t>(p) * per_unknown_stride, 0.0);
   gradient->setZero(p);
-  Eigen::MatrixXd own = Eigen::MatrixXd::Zero(p, p), across = Eigen::MatrixXd::Zero(p, p);
-  int local[kMaxCorners];
-  double weights[kMaxCorners];
-  double e[3];
-  for (int j = 0; j < n; ++j) {
-    const int corners = CornersOf(block, members[j], local, weights);
-    double own_scale = 0.0, gradient_scale = 0.0;
-    for (int c = 0; c < 3; ++c) e[c] = 0.0;
+  // sum_m W_mi W_mj D_m and sum_m W_mi W_mj F_m (D_m = sum_ac w^2 s^2 d^2, F_m = sum_c w^2 E^2).
+  thread_local std::vector<double> own, across;
+  own.assign(with_curvature ? static_cast<size_t>(p) * p : 0, 0.0);
+  across.assign(own.size(), 0.0);
+  MemberSums sums;
+  sums.n = n;
+  sums.p = p;
+  sums.with_curvature = with_curvature;
+  sums.s = s.data();
+  sums.w2 = w2.data();
+  sums.z = z.data();
+  sums.d = d.data();
+  sums.local = corners.local.data();
+  sums.corner_weights = corners.weights.data();
+  sums.zy = zy.data();
+  sums.gram = gram.data();
+  sums.per_unknown = per_unknown.data();
+  sums.gradient = gradient->data();
+  sums.own = own.data();
+  sums.across = across.data();
+  // The common camera counts compiled for, the others with the count as a variable.
+  switch (num_cameras) {
+    // clang-format off
+    case 2: SumMembers<2>(num_cameras, &sums); break;
+    case 3: SumMembers<3>(num_cameras, &sums); break;
+    case 4: SumMembers<4>(num_cameras, &sums); break;
+    case 5: SumMembers<5>(num_cameras, &sums); break;
+    case 6: SumMembers<6>(num_cameras, &sums); break;
+    case 7: SumMembers<7>(num_cameras, &sums); break;
+    case 8: SumMembers<8>(num_cameras, &sums); break;
+    default: SumMembers<0>(num_cameras, &sums);
+      // clang-format on
+  }
+  const double squared_norm = sums.squared_norm;
+
+  // v_i = s beta_i, beta the normalisation's mean of z dq (per channel, or over the three when
+  // the gain is pooled): g = sum_m W R_m - sum_ac w^2 v zy.
+  thread_local std::vector<double> v;
+  v.resize(static_cast<size_t>(p) * K);
+  for (int i = 0; i < p; ++i) {
+    const double* rho = &per_unknown[static_cast<size_t>(i) * per_unknown_stride];
+    double* vi = &v[static_cast<size_t>(i) * K];
     for (int a = 0; a < num_cameras; ++a) {
+      const double pooled_beta = (rho[3 * a] + rho[3 * a + 1] + rho[3 * a + 2]) / (3 * n);
       for (int c = 0; c < 3; ++c) {
-        const double sd = s_of(a, c) * d[at(a, j, c)];
-        e[c] += sd;
-        own_scale += w2[c] * sd * sd;
-        gradient_scale += w2[c] * sd * (z[at(a, j, c)] - mean_z[3 * j + c]);
+        const int t = 3 * a + c;
+        vi[t] = s[t] * (pooled ? pooled_beta : rho[t] / n);
+        (*gradient)[i] -= vi[t] * w2[t] * zy[t];
       }
     }
-    const double across_scale = w2[0] * e[0] * e[0] + w2[1] * e[1] * e[1] + w2[2] * e[2] * e[2];
-    for (int q = 0; q < corners; ++q) {
-      const int i = local[q];
-      const double wi = weights[q];
-      (*gradient)[i] += wi * gradient_scale;
-      for (int r = 0; r < corners; ++r) {
-        own(i, local[r]) += wi * weights[r] * own_scale;
-        across(i, local[r]) += wi * weights[r] * across_scale;
-      }
-      double* mu_i = mu(i);
-      double* rho_i = rho(i);
-      double* sz_i = sz(i);
-      for (int a = 0; a < num_cameras; ++a) {
-        for (int c = 0; c < 3; ++c) {
-          const double wd = wi * d[at(a, j, c)];
-          mu_i[3 * a + c] += wd;
-          rho_i[3 * a + c] += wd * z[at(a, j, c)];
-          sz_i[3 * a + c] += wi * e[c] * z[at(a, j, c)];
+  }
+  if (!with_curvature) return squared_norm;
+
+  // J^T J = A - B / C (the derivation's terms) gathered as
+  // H_ij = own_ij - across_ij / C - n sum w^2 u_i u_j + (n / C) sum_c w^2 u_hat_ic u_hat_jc
+  //        + sum (v_j x_i - v_i y_j - y_i v_j),
+  // with u = s mu / n, u_hat the sum of u over the cameras, y = w^2 (s rho - sigma / C) and
+  // x = w^2 (G_aa v - (G v) / C).
+  thread_local std::vector<double> u, u_hat, x, y;
+  u.resize(v.size());
+  x.resize(v.size());
+  y.resize(v.size());
+  u_hat.assign(static_cast<size_t>(p) * 3, 0.0);
+  for (int i = 0; i < p; ++i) {
+    const double* rho = &per_unknown[static_cast<size_t>(i) * per_unknown_stride];
+    const double* mu = rho + K;
+    const double* sigma = rho + 2 * K;
+    const double* vi = &v[static_cast<size_t>(i) * K];
+    double* ui = &u[static_cast<size_t>(i) * K];
+    double* xi = &x[static_cast<size_t>(i) * K];
+    double* yi = &y[static_cast<size_t>(i) * K];
+    for (int b = 0; b < num_cameras; ++b) {
+      for (int c = 0; c < 3; ++c) {
+        const int t = 3 * b + c;
+        double gv = 0.0;
+        for (int a = 0; a < num_cameras; ++a) {
+          gv += gram[(std::min(a, b) * num_cameras + std::max(a, b)) * 3 + c] * vi[3 * a + c];
         }
+        const double g_bb = gram[(b * num_cameras + b) * 3 + c];
+        ui[t] = s[t] * mu[t] / n;
+        u_hat[3 * i + c] += ui[t];
+        xi[t] = w2[t] * (g_bb * vi[t] - gv / num_cameras);
+        yi[t] = w2[t] * (s[t] * rho[t] - sigma[t] / num_cameras);
       }
     }
   }
-  // u_iac = s mu_iac and v_iac = s beta_iac, beta the normalisation's mean of z dq (per channel,
-  // or over the three when the gain is pooled); u_hat_ic = sum_a u_iac.
-  Eigen::MatrixXd u(p, channels), v(p, channels), u_hat(p, 3);
+  curvature->resize(p, p);
   for (int i = 0; i < p; ++i) {
-    for (int a = 0; a < num_cameras; ++a) {
-      const double pooled_beta = (rho(i)[3 * a] + rho(i)[3 * a + 1] + rho(i)[3 * a + 2]) / (3 * n);
-      for (int c = 0; c < 3; ++c) {
-        const double beta = pooled ? pooled_beta : rho(i)[3 * a + c] / n;
-        u(i, 3 * a + c) = s_of(a, c) * mu(i)[3 * a + c] / n;
-        v(i, 3 * a + c) = s_of(a, c) * beta;
+    const double* ui = &u[static_cast<size_t>(i) * K];
+    const double* vi = &v[static_cast<size_t>(i) * K];
+    const double* xi = &x[static_cast<size_t>(i) * K];
+    const double* yi = &y[static_cast<size_t>(i) * K];
+    for (int l = i; l < p; ++l) {
+      const double* ul = &u[static_cast<size_t>(l) * K];
+      const double* vl = &v[static_cast<size_t>(l) * K];
+      const double* yl = &y[static_cast<size_t>(l) * K];
+      double uu = 0.0, rest = 0.0;
+      for (int t = 0; t < K; ++t) {
+        uu += w2[t] * ui[t] * ul[t];
+        rest += vl[t] * (xi[t] - yi[t]) - vi[t] * yl[t];
       }
-    }
-    for (int c = 0; c < 3; ++c) {
-      u_hat(i, c) = 0.0;
-      for (int a = 0; a < num_cameras; ++a) u_hat(i, c) += u(i, 3 * a + c);
-    }
-  }
-  Eigen::VectorXd w2_channels(channels), own_gram(channels);
-  for (int a = 0; a < num_cameras; ++a) {
-    for (int c = 0; c < 3; ++c) {
-      w2_channels[3 * a + c] = w2[c];
-      own_gram[3 * a + c] = gram[(a * num_cameras + a) * 3 + c];
+      double uu_hat = 0.0;
+      for (int c = 0; c < 3; ++c) uu_hat += w2[c] * u_hat[3 * i + c] * u_hat[3 * l + c];
+      const double h = own[i * p + l] - across[i * p + l] / num_cameras - n * uu +
+                       n * uu_hat / num_cameras + rest;
+      (*curvature)(i, l) = (*curvature)(l, i) = h;
     }
   }
-  Eigen::MatrixXd s_rho(p, channels), w2_sz(p, channels);
-  for (int i = 0; i < p; ++i) {
-    for (int a = 0; a < num_cameras; ++a) {
-      for (int c = 0; c < 3; ++c) {
-        s_rho(i, 3 * a + c) = w2[c] * s_of(a, c) * rho(i)[3 * a + c];
-        w2_sz(i, 3 * a + c) = w2[c] * sz(i)[3 * a + c];
-      }
-    }
-  }
-  // g = sum_m W R_m - sum_ac w^2 v zy.
-  *gradient -= v * w2_channels.cwiseProduct(zy);
-  // J^T J = A - B / C (the derivation's terms, in its order).
-  const Eigen::MatrixXd v_w2 = v * w2_channels.asDiagonal();
-  const Eigen::MatrixXd u_w2 = u * w2_channels.asDiagonal();
-  Eigen::MatrixXd a_part = own - n * u_w2 * u.transpose() - v * s_rho.transpose() -
-                           s_rho * v.transpose() + v_w2 * own_gram.asDiagonal() * v.transpose();
-  Eigen::MatrixXd b_part = across - n * u_hat * w2.asDiagonal() * u_hat.transpose() -
-                           v * w2_sz.transpose() - w2_sz * v.transpose();
-  for (int c = 0; c < 3; ++c) {
-    Eigen::MatrixXd channel_gram(num_cameras, num_cameras);
-    Eigen::MatrixXd v_c(p, num_cameras);
-    for (int a = 0; a < num_cameras; ++a) {
-      v_c.col(a) = v.col(3 * a + c);
-      for (int b = 0; b < num_cameras; ++b) {
-        channel_gram(a, b) = gram[(a * num_cameras + b) * 3 + c];
-      }
-    }
-    b_part += w2[c] * v_c * channel_gram * v_c.transpose();
-  }
-  *curvature = a_part - b_part / num_cameras;
   return squared_norm;
 }
 
 double SurfaceConsensusSimilarity::BlockModel(int block, const Eigen::VectorXd& k,
                                               Eigen::VectorXd* gradient,
                                               Eigen::MatrixXd* curvature) const {
-  const double c2 = patches_.LossScale(block), weight = options_.surface_weight;
+  const double c2 = patches_.LossScale(patch_of_[block]), weight = options_.surface_weight;
   if (gradient == nullptr) {
     thread_local Eigen::VectorXd residuals;
     PlainResidualsOfBlock(block, k, &residuals, nullptr);
@@ -371,7 +669,7 @@ double SurfaceConsensusSimilarity::BlockModel(int block, const Eigen::VectorXd& 
   double squared_norm = PlainModelOfBlock(block, k, gradient, curvature);
   internal::Robustify(c2, &squared_norm, gradient, curvature);
   *gradient *= weight;
-  *curvature *= weight;
+  if (curvature != nullptr) *curvature *= weight;
   return weight * squared_norm;
 }
 
@@ -382,14 +680,13 @@ double SurfaceConsensusSimilarity::Evaluate(const Eigen::VectorXd& k,
 #pragma omp parallel
   {
     Eigen::VectorXd block_gradient;
-    Eigen::MatrixXd block_curvature;
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
       if (gradient == nullptr) {
         costs[b] = BlockModel(b, k, nullptr, nullptr);
         continue;
       }
-      costs[b] = BlockModel(b, k, &block_gradient, &block_curvature);
+      costs[b] = BlockModel(b, k, &block_gradient, nullptr);  // No J^T J: the gradient alone.
       std::copy_n(block_gradient.data(), block_gradient.size(), &entries[parameter_begin_[b]]);
     }
   }

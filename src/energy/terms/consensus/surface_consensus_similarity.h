@@ -11,6 +11,12 @@
 // cameras, reads, contrast weights and robust loss are those of the PixelConsensusSimilarity it is
 // built on.
 //
+// Each face lies in the patches of its three corners. With ConsensusOptions::surface_patches
+// kFaceCover (the default) the term compares it through one of them: its blocks are the patches
+// of a set of vertices with a corner on every face (an end on every edge where the faces are
+// split only once), about a third of the patches (two thirds), which on synth_skirt keep most of
+// what the term gains at a third of its cost (PatchOf); with kAll, through every patch.
+//
 // Why both terms, not this one alone: with the patches alone the mesh between the vertices is
 // never compared, and with this term alone neighbouring vertices may move against each other
 // where the images barely tell (the blend of two corners moving apart changes a sample less than
@@ -29,6 +35,7 @@
 #ifndef FINECAP_SRC_ENERGY_SURFACE_CONSENSUS_SIMILARITY_H_
 #define FINECAP_SRC_ENERGY_SURFACE_CONSENSUS_SIMILARITY_H_
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -56,6 +63,9 @@ class SurfaceConsensusSimilarity : public DataTerm {
   bool IsLeastSquares() const override { return true; }
   bool ReadsPairLists() const override { return false; }
 
+  // The block of the patch term (`patches`) whose patch block `block` compares.
+  int PatchOf(int block) const { return patch_of_[block]; }
+
   // Block `block`'s residuals r at `k`, weighted and after the robust loss (three per member,
   // camera and channel, in ReadPatch's order), and, when `jacobian` is not null, dr/dk of its
   // unknowns (one column each, in residual_blocks()[block].parameters' order): what its reduced
@@ -64,25 +74,32 @@ class SurfaceConsensusSimilarity : public DataTerm {
                         Eigen::MatrixXd* jacobian) const;
 
  private:
-  // The corners `sample` of block `block` is blended from, as indices into the block's unknowns
-  // (`local`), and its weights on them; returns how many (at most 3).
-  int CornersOf(int block, int sample, int* local, double* weights) const;
-  // Block b's colours with every sample where the mesh displaced by k puts it, normalised per
-  // camera (`z`; the inverse deviations, 3 a camera, in `inverse_deviations`) and, when
-  // `derivatives` is not null, the colours' derivatives in their own sample's displacement.
-  void ReadNormalised(int block, const Eigen::VectorXd& k, std::vector<double>* z,
-                      std::vector<double>* derivatives,
+  // The corners each member of block `block` is blended from, three a member: indices into the
+  // block's unknowns and the member's weights on them, those past its own corners of weight 0.
+  struct MemberCorners {
+    std::vector<uint16_t> local;
+    std::vector<double> weights;
+  };
+  void CornersOfMembers(int block, MemberCorners* corners) const;
+  // Sets member_begin_ and corner_local_.
+  void TabulateCorners();
+  // Block b's colours with every sample where the mesh displaced by k puts it (its `corners`),
+  // normalised per camera (`z`; the inverse deviations, 3 a camera, in `inverse_deviations`) and,
+  // when `derivatives` is not null, the colours' derivatives in their own sample's displacement.
+  void ReadNormalised(int block, const Eigen::VectorXd& k, const MemberCorners& corners,
+                      std::vector<double>* z, std::vector<double>* derivatives,
                       std::vector<double>* inverse_deviations) const;
   // The block's residuals before the loss and the weight at k and, when `jacobian` is not null,
   // their derivatives.
   void PlainResidualsOfBlock(int block, const Eigen::VectorXd& k, Eigen::VectorXd* residuals,
                              Eigen::MatrixXd* jacobian) const;
-  // The block's sum of squares before the loss and the weight, its J^T r and J^T J, from sums
-  // over its members and cameras instead of its Jacobian (docs/method.md derives them).
+  // The block's sum of squares before the loss and the weight, its J^T r and, when `curvature` is
+  // not null, J^T J, from sums over its members and cameras instead of its Jacobian
+  // (docs/method.md derives them).
   double PlainModelOfBlock(int block, const Eigen::VectorXd& k, Eigen::VectorXd* gradient,
                            Eigen::MatrixXd* curvature) const;
   // The block's weighted sum of squares after the loss and, when `gradient` is not null, its J^T r
-  // and J^T J (`curvature`).
+  // and, when `curvature` is not null, J^T J.
   double BlockModel(int block, const Eigen::VectorXd& k, Eigen::VectorXd* gradient,
                     Eigen::MatrixXd* curvature) const;
 
@@ -96,7 +113,8 @@ class SurfaceConsensusSimilarity : public DataTerm {
   const PixelConsensusSimilarity& patches_;
   const SurfaceSamples& samples_;
   ConsensusOptions options_;
-  std::vector<ResidualBlock> blocks_;  // Block b reads the patch of the patches' block b.
+  std::vector<ResidualBlock> blocks_;
+  std::vector<int> patch_of_;  // Block b reads the patch of the patches' block patch_of_[b].
   // PrepareResiduals' reduced rows from row_begin_[b] and their Jacobians (row-major) from
   // jacobian_begin_[b].
   std::vector<long> row_begin_, jacobian_begin_;
@@ -104,6 +122,10 @@ class SurfaceConsensusSimilarity : public DataTerm {
   // Block b's unknowns are entries parameter_begin_[b] .. of a list over all blocks; unknown s's
   // entries in it are contributions_[contribution_begin_[s] ..), ascending.
   std::vector<long> parameter_begin_, contribution_begin_, contributions_;
+  // Block b's members' corners as indices into its unknowns (MemberCorners::local), from
+  // kMaxCorners member_begin_[b]: looked up once, not at every evaluation.
+  std::vector<long> member_begin_;
+  std::vector<uint16_t> corner_local_;
 };
 
 }  // namespace finecap
