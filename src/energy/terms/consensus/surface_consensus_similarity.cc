@@ -82,25 +82,45 @@ int MostCorners(const PixelConsensusSimilarity& patches, const SurfaceSamples& s
 }
 
 // The faces of the mesh the patches' samples lie on, as their corners (ascending), each once:
-// the triangles of the vertices that share a sample.
+// those of the samples blended from three corners or, where the faces are split only once, the
+// triangles of the edges whose midpoints are samples. Gathered patch by patch, each patch's
+// distinct corner sets only, so that the lists grow with the mesh's faces, not with the samples.
 std::vector<std::array<int, 3>> FacesOfPatches(const PixelConsensusSimilarity& patches,
                                                const SurfaceSamples& samples) {
-  std::vector<std::vector<int>> adjacent(samples.weights.cols());
+  std::vector<std::array<int, 3>> faces, patch_faces;
+  std::vector<std::pair<int, int>> edges, patch_edges;
+  const auto append_distinct = [](auto* from, auto* to) {
+    std::sort(from->begin(), from->end());
+    from->erase(std::unique(from->begin(), from->end()), from->end());
+    to->insert(to->end(), from->begin(), from->end());
+    from->clear();
+  };
   for (int b = 0; b < static_cast<int>(patches.residual_blocks().size()); ++b) {
     const int* members = patches.Members(b);
     for (int j = 0; j < patches.PatchSize(b); ++j) {
+      std::array<int, 3> corners;
+      int count = 0;
       for (SampleWeights::InnerIterator it(samples.weights, members[j]); it; ++it) {
-        for (SampleWeights::InnerIterator other(samples.weights, members[j]); other; ++other) {
-          if (other.col() != it.col()) adjacent[it.col()].push_back(static_cast<int>(other.col()));
-        }
+        corners[count++] = static_cast<int>(it.col());
       }
+      std::sort(corners.begin(), corners.begin() + count);
+      if (count == 3) patch_faces.push_back(corners);
+      if (count == 2) patch_edges.push_back({corners[0], corners[1]});
     }
+    append_distinct(&patch_faces, &faces);
+    append_distinct(&patch_edges, &edges);
   }
-  for (std::vector<int>& list : adjacent) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
+  std::vector<std::array<int, 3>> distinct_faces;
+  append_distinct(&faces, &distinct_faces);
+  if (!distinct_faces.empty()) return distinct_faces;
+  std::vector<std::pair<int, int>> distinct_edges;
+  append_distinct(&edges, &distinct_edges);
+  std::vector<std::vector<int>> adjacent(samples.weights.cols());
+  for (const auto& [a, c] : distinct_edges) {
+    adjacent[a].push_back(c);
+    adjacent[c].push_back(a);
   }
-  std::vector<std::array<int, 3>> faces;
+  for (std::vector<int>& list : adjacent) std::sort(list.begin(), list.end());
   for (int v = 0; v < static_cast<int>(adjacent.size()); ++v) {
     for (int a : adjacent[v]) {
       if (a < v) continue;
