@@ -191,13 +191,13 @@ std::vector<int> ColourVertices(const std::vector<std::array<int, 3>>& faces, in
 
 // The patches through which the term compares every sample between the vertices once, ascending.
 // Every patch holds all the faces of its vertex, so that each face is compared in the patches of
-// its three corners; comparing it in one compares the same pixels, and costs a third (on
-// synth_skirt a third of the patches keep most of what the term gains, docs/measurements.md,
-// 2026-12-06). With samples inside the faces: the patches of one colour of ColourVertices, which
-// has a corner on every face of a regular mesh; with the faces split once, whose only samples
-// between vertices are the edges' midpoints: two colours, an end of every edge. Then the patches
-// that hold a sample between vertices that none of them holds (irregular vertices, a mask's
-// cut), in order; of the three choices of colours, the one with the fewest patches.
+// its three corners; comparing it in one compares the same pixels, and costs a third (a third
+// of the patches keep half to all of what the term gains on the captures measured,
+// docs/measurements.md, 2026-12-06). With samples inside the faces: the patches of one colour of
+// ColourVertices, which has a corner on every face of a regular mesh; with the faces split once,
+// whose only samples between vertices are the edges' midpoints: two colours, an end of every edge.
+// Then the patches that hold a sample between vertices that none of them holds (irregular vertices,
+// a mask's cut), in order; of the three choices of colours, the one with the fewest patches.
 std::vector<int> FaceCoveringPatches(const PixelConsensusSimilarity& patches,
                                      const SurfaceSamples& samples) {
   const int num_patches = static_cast<int>(patches.residual_blocks().size());

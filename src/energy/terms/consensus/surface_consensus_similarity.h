@@ -14,8 +14,9 @@
 // Each face lies in the patches of its three corners. With ConsensusOptions::surface_patches
 // kFaceCover (the default) the term compares it through one of them: its blocks are the patches
 // of a set of vertices with a corner on every face (an end on every edge where the faces are
-// split only once), about a third of the patches (two thirds), which on synth_skirt keep most of
-// what the term gains at a third of its cost (PatchOf); with kAll, through every patch.
+// split only once), about a third of the patches (two thirds), which keep half to all of what
+// the term gains on the captures measured, at a third of its cost (PatchOf); with kAll, through
+// every patch.
 //
 // Why both terms, not this one alone: with the patches alone the mesh between the vertices is
 // never compared, and with this term alone neighbouring vertices may move against each other
