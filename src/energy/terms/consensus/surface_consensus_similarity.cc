@@ -344,20 +344,18 @@ SurfaceConsensusSimilarity::SurfaceConsensusSimilarity(const PixelConsensusSimil
                                                        const ConsensusOptions& options)
     : patches_(patches), samples_(samples), options_(options) {
   options_.Check();
-  const int num_patches = static_cast<int>(patches.residual_blocks().size());
-  std::vector<std::vector<int>> unknowns(num_patches);
-  for (int b = 0; b < num_patches; ++b) unknowns[b] = CornersOfPatch(patches, samples, b);
   if (options_.surface_patches == SurfacePatches::kFaceCover) {
     patch_of_ = FaceCoveringPatches(patches, samples);
   } else {
-    patch_of_.resize(num_patches);
+    patch_of_.resize(patches.residual_blocks().size());
     std::iota(patch_of_.begin(), patch_of_.end(), 0);
   }
   row_begin_.assign(1, 0);
   jacobian_begin_.assign(1, 0);
   for (int patch : patch_of_) {
-    const int p = static_cast<int>(unknowns[patch].size());
-    blocks_.push_back({std::move(unknowns[patch]), p + 1});
+    std::vector<int> unknowns = CornersOfPatch(patches, samples, patch);
+    const int p = static_cast<int>(unknowns.size());
+    blocks_.push_back({std::move(unknowns), p + 1});
     row_begin_.push_back(row_begin_.back() + p + 1);
     jacobian_begin_.push_back(jacobian_begin_.back() + static_cast<long>(p + 1) * p);
   }
@@ -702,11 +700,9 @@ double SurfaceConsensusSimilarity::Evaluate(const Eigen::VectorXd& k,
     Eigen::VectorXd block_gradient;
 #pragma omp for schedule(dynamic, 64)
     for (int b = 0; b < num_blocks; ++b) {
-      if (gradient == nullptr) {
-        costs[b] = BlockModel(b, k, nullptr, nullptr);
-        continue;
-      }
-      costs[b] = BlockModel(b, k, &block_gradient, nullptr);  // No J^T J: the gradient alone.
+      // No J^T J: the gradient alone.
+      costs[b] = BlockModel(b, k, gradient != nullptr ? &block_gradient : nullptr, nullptr);
+      if (gradient == nullptr) continue;
       std::copy_n(block_gradient.data(), block_gradient.size(), &entries[parameter_begin_[b]]);
     }
   }
