@@ -13,8 +13,11 @@
 # Sceaux castle (SCEAUX=DIR, default ../shared/captures/openmvs_sceaux) and, when SCEAUX_FULL names
 # one, the Sceaux castle at full resolution; each is read where it is. A capture with a
 # heldout.yaml (Sceaux) is refined with it, as its README says, unless CONFIG is given. One row
-# per capture: forecast and measured MB (the peak over the frames run) and their ratio; the
-# forecast seconds of a frame (the held-out score included), the first frame's wall-clock seconds
+# per capture: the forecast refine announced, the forecast at the search range the run ended with
+# (`finecap info` with energy.k_max set to the widest k_max_mm of stats.jsonl: a frame whose plane
+# sweep widened its range holds the pairs and colour tables of the wider range; the larger of the
+# two, as a range narrowed by the sweep was held at the configured range first), the measured MB
+# (the peak over the frames run) and its ratio to the larger forecast; the forecast seconds of a frame (the held-out score included), the first frame's wall-clock seconds
 # and its CPU seconds over two cores, and the ratio of the wall-clock seconds to the forecast;
 # exits 1 when a memory ratio lies outside [0.8, 1.25] or a time ratio outside [0.5, 2].
 #
@@ -48,8 +51,8 @@ if [ ${#captures[@]} -eq 0 ]; then
 fi
 
 status=0
-printf "%-24s %11s %11s %6s %10s %7s %9s %6s %5s\n" capture forecast_mb measured_mb ratio \
-  forecast_s wall_s cpu_s/2 ratio load
+printf "%-24s %11s %9s %11s %6s %10s %7s %9s %6s %5s\n" capture forecast_mb at_range \
+  measured_mb ratio forecast_s wall_s cpu_s/2 ratio load
 for capture in "${captures[@]}"; do
   args=()
   if [ -n "${CONFIG:-}" ]; then
@@ -57,11 +60,13 @@ for capture in "${captures[@]}"; do
   elif [ -f "$capture/heldout.yaml" ]; then
     args+=(--config "$capture/heldout.yaml")
   fi
-  [ -n "${SET:-}" ] && args+=(--set "$SET")
+  refine_set=${SET:-}
+  info_set=${SET:+$SET,}
   name=$(basename "$capture")
   out="$work/run_$name"
   load=$(cut -d' ' -f1 /proc/loadavg)
   build/finecap refine --capture "$capture" --out "$out" --frames "$frames" "${args[@]}" \
+    ${refine_set:+--set "$refine_set"} \
     >"$work/stdout" 2>"$work/stderr" || { cat "$work/stderr" >&2; exit 1; }
   forecast=$(grep -o 'expected peak memory [0-9]*' "$work/stderr" | awk '{ print $4 }')
   # "..., about T s|min per frame" (after "(up to ...)" when a frame may widen its range).
@@ -73,10 +78,17 @@ for capture in "${captures[@]}"; do
   seconds=$(head -n 1 "$out/stats.jsonl" | grep -o '"seconds": [0-9.eE+-]*' | cut -d' ' -f2)
   cpu=$(head -n 1 "$out/stats.jsonl" | grep -o '"cpu_seconds": [0-9.eE+-]*' |
     awk '{ printf "%.2f", $2 / 2 }')
-  ratio=$(echo "$forecast $measured" | awk '{ printf "%.2f", $2 / $1 }')
+  # The forecast at the widest range a frame ended with, metres.
+  range_m=$(grep -o '"k_max_mm": [0-9.eE+-]*' "$out/stats.jsonl" |
+    awk '{ if ($2 > m) m = $2 } END { printf "%.6g", m / 1000 }')
+  at_range=$(build/finecap info --capture "$capture" --frames "$frames" "${args[@]}" \
+    --set "${info_set}energy.k_max=$range_m,refine.sweep.max_widenings=0" 2>/dev/null |
+    grep -o 'peak memory [0-9]*' | awk '{ print $3 }')
+  larger=$(echo "$forecast $at_range" | awk '{ print ($2 > $1) ? $2 : $1 }')
+  ratio=$(echo "$larger $measured" | awk '{ printf "%.2f", $2 / $1 }')
   ratio_s=$(echo "$forecast_s $seconds" | awk '{ if ($1 > 0) printf "%.2f", $2 / $1; else print "inf" }')
-  printf "%-24s %11s %11.0f %6s %10s %7.1f %9s %6s %5s\n" "$name" "$forecast" "$measured" "$ratio" \
-    "$forecast_s" "$seconds" "$cpu" "$ratio_s" "$load"
+  printf "%-24s %11s %9s %11.0f %6s %10s %7.1f %9s %6s %5s\n" "$name" "$forecast" "$at_range" \
+    "$measured" "$ratio" "$forecast_s" "$seconds" "$cpu" "$ratio_s" "$load"
   awk -v l="$load" 'BEGIN { exit !(l > 2.5) }' &&
     echo "$name: the load average was $load before the run: its wall time counts other work" >&2
   awk -v r="$ratio" 'BEGIN { exit !(r >= 0.8 && r <= 1.25) }' ||

@@ -48,9 +48,9 @@ constexpr double kTabledBytesPerObservation = 40.0;
 // normal equations and factor add.
 constexpr double kBytesPerSurfaceGaussian = 1100.0;
 constexpr double kBytesPerSurfaceGaussianCholesky = 400.0;  // synth_skirt: 104 against 100 MB.
-// A run of several frames prepares up to two ahead while one is solved (sequence.cc), and holds
-// three frames' worth at its peak even with two frames to run (synth_skirt: 166 MB for two frames,
-// 173 MB for three).
+// Without the detail stage a run of several frames prepares up to two ahead while one is solved
+// (sequence.cc), and holds three frames' worth at its peak even with two frames to run
+// (synth_skirt: 166 MB for two frames, 173 MB for three).
 constexpr int kFramesHeldBySeveral = 3;
 
 // Seconds of one frame without the detail stage: the pairs dominate large problems (the colour
@@ -60,31 +60,41 @@ constexpr int kFramesHeldBySeveral = 3;
 constexpr double kSecondsPerPair = 0.16e-6;
 constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 
-// With the detail stage (ConsensusOptions::sample_spacing, the default), which the constants above
-// predate: the forecast of 2026-12-04 held none of the real captures (measured / forecast: the
-// temple 0.71, Sceaux 0.86, Sceaux at full resolution 0.79 for memory; 2.0 for time at full
-// resolution), so the default path has constants of its own, fitted to 9 runs on 2 cores: the
-// first frame of synth_demo (4 cameras of 512 px, 3 sample levels), synth_skirt (8 cameras of
-// 1004 px; one frame, and two with three frames held), the Middlebury temple (16 cameras, and 12
-// with configs/temple.yaml), Sceaux (10 cameras of 708 x 532, and 8 with its heldout.yaml), Sceaux
-// at full resolution (8 of 2832 x 2128, 4 sample levels, bench/sceaux_full_resolution.sh) and the
-// soak's capture (bench/soak.sh: 6 cameras of 80 px, three frames held); 31 MB to 2.7 GB.
+// With the detail stage (ConsensusOptions::sample_spacing, the default) a frame's memory has two
+// peaks, not one sum: the surface Gaussians' stage (the images read, the pairs while they are
+// built, the colour tables) and the detail stage (the images as floats, blurred, the surface
+// samples, the table of the reads' rays). The first stage's energy is freed before the detail
+// stage is built, but the allocator keeps its pages, which the detail stage then reuses: the
+// resident memory after the first stage never falls (watched through /proc/self/status on the
+// temple and Sceaux), and the peak is the larger of the two. A run of several frames also holds
+// the frame read and prepared ahead (one, as the detail stage reads its frame's images after the
+// preparation: sequence.cc), its images and its colour tables, its pairs freed once the tables
+// are made.
 //
-// Memory: the worst ratio made smallest (a grid over the three constants below, the process's
-// 29 MB and the colour tables, an exact count, held fixed), over the 9 runs and a second run of
-// 4 of them (peaks move by up to 8 % from run to run): all within 0.85-1.18 of their measured
-// peaks. Each camera's image as 3 floats a pixel, blurred, and what reading and preparing it
-// holds; per pair while the pairs are built; per surface sample its position, direction, blend
-// weights and visibility. The surface Gaussians' own share (kBytesPerSurfaceGaussian) fitted to
-// zero in a least-squares fit with it free: the other terms hold it. synth_demo is the only run
-// with 3 sample levels (169 samples a patch): left out of that least-squares fit, it came out at
-// 2.4 times its forecast, so a capture sampled that finely is forecast from one run.
-constexpr double kBytesPerSampledPixel = 9.8;  // Beside kBytesPerPixel's 4.2.
-constexpr double kBytesPerConsensusPairWithSamples = 1.0;
-constexpr double kBytesPerSurfaceGaussianWithSamples = 0.0;
-constexpr double kBytesPerSurfaceSample = 205.0;
-// Time, measured as the frame's CPU seconds over 2 cores (the machine was shared, wall clocks 2
-// to 4 times that), minimax on the log ratio: all 9 within 0.59-1.69. Per pair (the colour tables
+// Fitted 2026-12-06 (a grid minimising the worst log ratio, the process's 29 MB and the colour
+// tables, an exact count, held fixed) to the first frames of seven runs on 2 cores, each at the
+// search range it ended with: synth_demo (4 cameras of 512 px, 3 sample levels), synth_skirt (8
+// cameras of 1004 px), the Middlebury temple (16 cameras, and 12 with configs/temple.yaml, at
+// the 16.6 mm its sweep widened to), Sceaux (10 cameras of 708 x 532, and 8 with its
+// heldout.yaml) and Sceaux at full resolution (8 of 2832 x 2128, 4 sample levels; too many reads
+// to keep their table): every run's peak within 0.93-1.08 of its forecast, and the first stage's
+// own peak, measured apart, within 0.93-1.08 of its part. A two-frame synth_skirt run came to
+// 0.98 of its forecast. The constants' sizes are those of what they count: 4.5 bytes a pixel
+// for the 8-bit images and their decoding, 6.5 a pair (the pair lists' 8 bytes, most of them
+// held at once), 18.5 a pixel for the detail stage's images (3 floats, the blur's buffer, the
+// 8-bit images still held) and 270 a sample (position, normal, blend weights, visibility flags
+// per camera, the patches' member lists).
+constexpr double kBytesPerPixelWithSamples = 4.5;
+constexpr double kBytesPerConsensusPairWithSamples = 6.5;
+constexpr double kBytesPerSampledPixel = 18.5;
+constexpr double kBytesPerSurfaceSample = 270.0;
+// The refined mesh's term (ConsensusOptions::surface_weight > 0), per surface sample: its blocks'
+// members' corners and blend weights, and its rows. Measured as the difference it makes to the
+// peak: synth_skirt 50, Sceaux (8 cameras) 70, Sceaux at full resolution 46 bytes a sample.
+constexpr double kBytesPerSurfaceSampleOfTheMeshTerm = 50.0;
+// Time, fitted 2026-12-04 to 9 runs (the captures above, two frames of synth_skirt and the soak's
+// capture), measured as the frame's CPU seconds over 2 cores (the machine was shared, wall clocks
+// 2 to 4 times that), minimax on the log ratio: all 9 within 0.59-1.69. Per pair (the colour tables
 // are built over them), and per sample read in a patch in one camera over the evaluations of the
 // detail stage's two passes. The spread is real: a read in a full-resolution image (72 MB of
 // floats a camera) misses the caches that the 708 x 532 images fit in, and Sceaux at full
@@ -129,20 +139,53 @@ double CountPairs(const std::vector<Camera>& cameras, const std::vector<ImageGau
   return pairs;
 }
 
-// The bytes of a frame held that grow with its search range `k_max`: its `num_pairs` while they
-// are built and, for the consensus similarity, its colour tables over the range.
-double RangeBytesPerFrame(double num_pairs, long num_observations, EnergyOptions energy,
-                          double k_max, double sigma_hat) {
+// The bytes of a frame that grow with its search range `k_max`: its `num_pairs` while they are
+// built and, for the consensus similarity, its colour tables over the range.
+struct RangeBytes {
+  double pairs = 0.0;
+  double tables = 0.0;
+};
+
+RangeBytes RangeBytesOf(double num_pairs, long num_observations, EnergyOptions energy, double k_max,
+                        double sigma_hat) {
   const SimilarityNeeds needs = NeedsOf(energy);
-  double bytes = num_pairs * (needs.reads_surface_samples ? kBytesPerConsensusPairWithSamples
-                              : needs.compares_patches    ? kBytesPerConsensusPair
-                                                          : kBytesPerPair);
+  RangeBytes bytes;
+  bytes.pairs = num_pairs * (needs.reads_surface_samples ? kBytesPerConsensusPairWithSamples
+                             : needs.compares_patches    ? kBytesPerConsensusPair
+                                                         : kBytesPerPair);
   energy.k_max = k_max;
   if (const int nodes = ColorTableNodes(energy, sigma_hat); nodes > 0) {
     // Its colour tables: value and derivative, 3 floats each, per node.
-    bytes += num_observations * (nodes * 24.0 + kTabledBytesPerObservation);
+    bytes.tables = num_observations * (nodes * 24.0 + kTabledBytesPerObservation);
   }
   return bytes;
+}
+
+// The bytes of the detail stage of a frame of `size` (its pixels, samples and observations set):
+// the images as floats, the samples, the reads' table where it is kept and, with
+// `mesh_term`, the refined mesh's term.
+double DetailStageBytes(const ProblemSize& size, bool mesh_term) {
+  const double reads = size.num_observations * double(size.samples_per_patch);
+  return size.num_pixels * kBytesPerSampledPixel +
+         size.num_surface_samples *
+             (kBytesPerSurfaceSample + (mesh_term ? kBytesPerSurfaceSampleOfTheMeshTerm : 0.0)) +
+         SampleRayTableBytes(reads);
+}
+
+// The peak bytes, beyond the process's own and the undistortion maps, of a run of `num_frames`
+// frames of `size` whose range takes `range`, with a detail stage of `detail_bytes` when it has
+// one (`sampled`).
+double FramesBytes(const ProblemSize& size, const RangeBytes& range, bool sampled,
+                   double detail_bytes, int num_frames) {
+  if (!sampled) {
+    const int frames_held = num_frames > 1 ? kFramesHeldBySeveral : 1;
+    return size.num_pixels * kBytesPerPixel + frames_held * (range.pairs + range.tables) +
+           size.num_surface_gaussians * kBytesPerSurfaceGaussian;
+  }
+  const double images = size.num_pixels * kBytesPerPixelWithSamples;
+  const double first_stage = images + range.pairs + range.tables;
+  const double frame_ahead = num_frames > 1 ? images + range.tables : 0.0;
+  return frame_ahead + std::max(first_stage, detail_bytes);
 }
 
 }  // namespace
@@ -181,50 +224,45 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     return CountPairs(frame.cameras, images, surface, visible, options.energy, k_max);
   };
   size.num_pairs = pairs_within(options.energy.k_max);
-  const double per_frame = RangeBytesPerFrame(size.num_pairs, size.num_observations, options.energy,
-                                              options.energy.k_max, options.sigma_hat);
+  const RangeBytes range = RangeBytesOf(size.num_pairs, size.num_observations, options.energy,
+                                        options.energy.k_max, options.sigma_hat);
   const bool sampled = NeedsOf(options.energy).reads_surface_samples;
   double detail_bytes = 0.0, detail_seconds = 0.0;
   if (sampled) {
     const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
     size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
     size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
-    const double reads = size.num_observations * double(size.samples_per_patch);
-    detail_bytes = size.num_pixels * kBytesPerSampledPixel +
-                   size.num_surface_samples * kBytesPerSurfaceSample + SampleRayTableBytes(reads);
-    detail_seconds = reads * kSecondsPerSampleRead;
+    detail_bytes = DetailStageBytes(size, options.energy.consensus.surface_weight > 0.0);
+    detail_seconds = size.num_observations * double(size.samples_per_patch) * kSecondsPerSampleRead;
   }
   const bool cholesky = options.solver.type == SolverType::kCeres &&
                         options.solver.linear_solver != LinearSolverType::kCgnr;
-  const int frames_held = num_frames > 1 ? kFramesHeldBySeveral : 1;
-  const double bytes =
-      size.num_pixels * kBytesPerPixel + undistorted_pixels * kBytesPerUndistortedPixel +
-      frames_held * per_frame + detail_bytes +
-      size.num_surface_gaussians *
-          ((sampled ? kBytesPerSurfaceGaussianWithSamples : kBytesPerSurfaceGaussian) +
-           (cholesky ? kBytesPerSurfaceGaussianCholesky : 0.0));
-  size.peak_memory_mb = kBaseMegabytes + bytes / 1e6;
+  const double run_bytes =
+      undistorted_pixels * kBytesPerUndistortedPixel +
+      (cholesky ? size.num_surface_gaussians * kBytesPerSurfaceGaussianCholesky : 0.0);
+  const auto peak_mb = [&](const RangeBytes& frame_range) {
+    return kBaseMegabytes +
+           (run_bytes + FramesBytes(size, frame_range, sampled, detail_bytes, num_frames)) / 1e6;
+  };
+  size.peak_memory_mb = peak_mb(range);
   size.widest_k_max = WidestSearchRange(options);
   size.widest_peak_memory_mb = size.peak_memory_mb;
   if (size.widest_k_max > options.energy.k_max) {
-    const double widest_pairs = pairs_within(size.widest_k_max);
-    size.widest_peak_memory_mb +=
-        frames_held *
-        (RangeBytesPerFrame(widest_pairs, size.num_observations, options.energy, size.widest_k_max,
-                            options.sigma_hat) -
-         per_frame) /
-        1e6;
+    size.widest_peak_memory_mb =
+        peak_mb(RangeBytesOf(pairs_within(size.widest_k_max), size.num_observations, options.energy,
+                             size.widest_k_max, options.sigma_hat));
   }
   size.seconds_per_frame = sampled ? size.num_pairs * kSecondsPerPairWithSamples + detail_seconds
                                    : size.num_pairs * kSecondsPerPair +
                                          size.num_surface_gaussians * kSecondsPerSurfaceGaussian;
   // What a refit of the constants needs beside each run's measured peak and time.
-  VLOG(1) << "memory forecast of " << frames_held << " frame(s) held: " << size.num_pixels
-          << " pixels, " << undistorted_pixels << " undistorted, " << size.num_pairs << " pairs, "
+  VLOG(1) << "memory forecast of " << num_frames << " frame(s): " << size.num_pixels << " pixels, "
+          << undistorted_pixels << " undistorted, " << size.num_pairs << " pairs, "
           << size.num_observations << " observations of " << size.num_surface_gaussians
           << " surface Gaussians, " << size.num_surface_samples << " surface samples, "
-          << size.samples_per_patch << " samples a patch; per frame " << per_frame / 1e6
-          << " MB, detail " << detail_bytes / 1e6 << " MB, " << (cholesky ? "Cholesky" : "CGNR");
+          << size.samples_per_patch << " samples a patch; pairs " << range.pairs / 1e6
+          << " MB, colour tables " << range.tables / 1e6 << " MB, detail stage "
+          << detail_bytes / 1e6 << " MB, " << (cholesky ? "Cholesky" : "CGNR");
   return size;
 }
 
@@ -253,8 +291,8 @@ void RequireMemoryFor(const ProblemSize& size, int num_frames, const RefineOptio
           << size.num_pixels / 1e6 << " Mpixel a frame over " << size.visible_per_camera.size()
           << " cameras)";
   if (num_frames > 1) {
-    problem << " or the frames held at once (a run of several frames prepares two ahead, three "
-               "frames' worth; one frame a run, --frames I:I+1, holds one)";
+    problem << " or the frames held at once (a run of several frames prepares the next ones "
+               "while one is solved; one frame a run, --frames I:I+1, holds one)";
   }
   problem << (own_limit ? ", or raise SequenceOptions::max_memory_mb" : ", or free memory for it");
   throw Error(own_limit ? "SequenceOptions::max_memory_mb" : available.source, problem.str());

@@ -6,9 +6,12 @@
 // millions of pairs when the Gaussians are large against the image), and their length depends on
 // sigma_hat, k_max and the texture, so the forecast counts them: it builds the frame's image
 // Gaussians and the pairs of a sample of the surface Gaussians (every n-th, enough for a count
-// within a few per cent), without keeping them. The bytes per item (problem_size.cc) were fitted
-// to the peak RSS of refinements of synth_skirt, synth_demo and the Middlebury temple, measured
-// with bench/memory_forecast.sh on 2 cores; a machine with many more cores keeps more per-thread
+// within a few per cent), without keeping them. With the detail stage a frame's memory peaks
+// either while its surface Gaussians' energy is built or in the detail stage, which reuses that
+// energy's memory once it is freed, and the forecast is the larger. The bytes per item
+// (problem_size.cc) were fitted to the peak RSS of refinements of the synthetic captures, the
+// Middlebury temple and Sceaux (at two resolutions), measured with bench/memory_forecast.sh on 2
+// cores; a machine with many more cores keeps more per-thread
 // memory (stacks, allocator arenas). The forecast is that of the configured level: the coarser
 // levels of a coarse-to-fine schedule are solved before it and freed, and measured no higher
 // (synth_skirt and the temple with refine.coarse_to_fine.levels 2: 3 % and 2 % above the
@@ -64,11 +67,11 @@ struct ProblemSize {
 
 // The problem of refining `frame` (coarse mesh, cameras, images) with `model`, `colors` and
 // `options` (whose lengths should be resolved: scene_scale.h), in a run of `num_frames` frames
-// like it: with more than one, up to two frames ahead are read and prepared while one is solved,
-// and the memory forecast holds three frames' worth. Builds the frame's image Gaussians and
-// visibility, so it costs a few seconds on a large rig, and keeps none of it. `undistorted_pixels`:
-// the pixels of the cameras whose images are undistorted as they are read (UndistortedPixels),
-// whose maps are held for the whole run.
+// like it: with more than one, the frames ahead are read and prepared while one is solved (one
+// with the detail stage, two without), and the memory forecast holds them too. Builds the frame's
+// image Gaussians and visibility, so it costs a few seconds on a large rig, and keeps none of it.
+// `undistorted_pixels`: the pixels of the cameras whose images are undistorted as they are read
+// (UndistortedPixels), whose maps are held for the whole run.
 ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColors& colors,
                                 const FrameInput& frame, const RefineOptions& options,
                                 int num_frames = 1, double undistorted_pixels = 0.0);
