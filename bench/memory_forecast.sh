@@ -17,8 +17,9 @@
 # (`finecap info` with energy.k_max set to the widest k_max_mm of stats.jsonl: a frame whose plane
 # sweep widened its range holds the pairs and colour tables of the wider range; the larger of the
 # two, as a range narrowed by the sweep was held at the configured range first), the measured MB
-# (the peak over the frames run) and its ratio to the larger forecast; the forecast seconds of a frame (the held-out score included), the first frame's wall-clock seconds
-# and its CPU seconds over two cores, and the ratio of the wall-clock seconds to the forecast;
+# (the peak over the frames run) and its ratio to the larger forecast; the forecast seconds of a
+# frame (the held-out score included), the first frame's wall-clock seconds and its CPU seconds
+# over two cores, and the ratio of the wall-clock seconds to the forecast;
 # exits 1 when a memory ratio lies outside [0.8, 1.25] or a time ratio outside [0.5, 2].
 #
 # The time forecast is that of 2 idle cores, and the wall clock of a shared machine measures the

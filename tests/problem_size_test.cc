@@ -81,11 +81,11 @@ TEST_F(ProblemSizeTest, SizesAreThoseOfThePreparedFrame) {
 // Without the detail stage a frame's memory peaks in its first stage, whose pairs and colour
 // tables grow with the range.
 TEST_F(ProblemSizeTest, MoreReachMeansMorePairsAndMoreMemory) {
-  RefineOptions narrow = options_;
-  narrow.energy.consensus.sample_spacing = 0.0;
+  RefineOptions first_stage_only = options_;
+  first_stage_only.energy.consensus.sample_spacing = 0.0;
   PreparedFrame prepared;
-  const ProblemSize size = Estimate(narrow, &prepared);
-  RefineOptions wider = narrow;
+  const ProblemSize size = Estimate(first_stage_only, &prepared);
+  RefineOptions wider = first_stage_only;
   wider.energy.k_max *= 3.0;
   const ProblemSize wide = Estimate(wider, &prepared);
   EXPECT_GT(wide.num_pairs, size.num_pairs);

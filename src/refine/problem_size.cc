@@ -161,15 +161,20 @@ RangeBytes RangeBytesOf(double num_pairs, long num_observations, EnergyOptions e
   return bytes;
 }
 
+// The samples the detail stage of a frame of `size` reads in one evaluation: each patch's in each
+// camera that sees it.
+double SampleReads(const ProblemSize& size) {
+  return size.num_observations * double(size.samples_per_patch);
+}
+
 // The bytes of the detail stage of a frame of `size` (its pixels, samples and observations set):
 // the images as floats, the samples, the reads' table where it is kept and, with
 // `mesh_term`, the refined mesh's term.
 double DetailStageBytes(const ProblemSize& size, bool mesh_term) {
-  const double reads = size.num_observations * double(size.samples_per_patch);
   return size.num_pixels * kBytesPerSampledPixel +
          size.num_surface_samples *
              (kBytesPerSurfaceSample + (mesh_term ? kBytesPerSurfaceSampleOfTheMeshTerm : 0.0)) +
-         SampleRayTableBytes(reads);
+         SampleRayTableBytes(SampleReads(size));
 }
 
 // The peak bytes, beyond the process's own and the undistortion maps, of a run of `num_frames`
@@ -233,7 +238,7 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
     size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
     size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
     detail_bytes = DetailStageBytes(size, options.energy.consensus.surface_weight > 0.0);
-    detail_seconds = size.num_observations * double(size.samples_per_patch) * kSecondsPerSampleRead;
+    detail_seconds = SampleReads(size) * kSecondsPerSampleRead;
   }
   const bool cholesky = options.solver.type == SolverType::kCeres &&
                         options.solver.linear_solver != LinearSolverType::kCgnr;
