@@ -256,6 +256,102 @@ TEST(PixelConsensusTest, ScalarIsMinusHalfTheSumOfTheBlockCosts) {
   EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
 }
 
+// A block's summary is formed from its colours without writing its residuals: it must be the
+// summary of those residuals (sum of squares, <r, dr/dk>, |dr/dk|^2), with and without the robust
+// loss, with one gain per camera or one per channel.
+class SummaryOfResidualsTest : public testing::TestWithParam<std::tuple<double, bool>> {};
+
+TEST_P(SummaryOfResidualsTest, SummariesAreThoseOfTheResidualsThemselves) {
+  const auto [robust_fraction, gain_per_channel] = GetParam();
+  const SampledScene scene = MakeSampledScene(0.001);
+  ConsensusOptions options = SampledOptions().consensus;
+  options.robust_fraction = robust_fraction;
+  options.gain_per_channel = gain_per_channel;
+  PixelConsensusSimilarity term(scene.samples, scene.cameras, options);
+  const int num_blocks = static_cast<int>(term.residual_blocks().size());
+  ASSERT_GT(num_blocks, 20);
+  const Eigen::VectorXd k = RandomK(scene.surface.size(), 0.002, 11);
+  term.PrepareBlockSummaries(k);
+  term.PrepareResiduals(k, true);
+  double largest_gradient = 0.0;
+  for (int b = 0; b < num_blocks; ++b) {
+    const int m = term.residual_blocks()[b].num_residuals;
+    std::vector<double> residuals(m), jacobian(m);
+    term.BlockResiduals(b, residuals.data(), jacobian.data());
+    const BlockSummary expected =
+        SummarisedDataTerm::Summarise(residuals.data(), jacobian.data(), m);
+    const BlockSummary summary = term.BlockSummaryOf(b);
+    const auto tolerance = [](double value) { return 1e-10 * std::max(std::abs(value), 1.0); };
+    EXPECT_NEAR(summary.squared_norm, expected.squared_norm, tolerance(expected.squared_norm))
+        << "block " << b;
+    EXPECT_NEAR(summary.gradient, expected.gradient, tolerance(expected.gradient)) << "block " << b;
+    EXPECT_NEAR(summary.curvature, expected.curvature, tolerance(expected.curvature))
+        << "block " << b;
+    largest_gradient = std::max(largest_gradient, std::abs(expected.gradient));
+  }
+  EXPECT_GT(largest_gradient, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(PixelConsensusTest, SummaryOfResidualsTest,
+                         testing::Combine(testing::Values(0.0, 0.5), testing::Bool()));
+
+// Camera weights make the cameras' mean a weighted one and count each camera's squared
+// residuals its weight's times: two cameras of weights 1 and 3, one member of one channel.
+TEST(AgainstCameraMeanTest, WeightsTheMeanAndTheSquaredResiduals) {
+  // One member (three channels) in each of two cameras: z = 1 in the first, 5 in the second.
+  double values[6] = {1.0, 1.0, 1.0, 5.0, 5.0, 5.0};
+  const double weights[2] = {1.0, 3.0};
+  internal::AgainstCameraMean(1, 2, Eigen::Vector3d::Ones(), values, weights);
+  const double mean = (1.0 * 1.0 + 3.0 * 5.0) / 4.0;  // 4
+  EXPECT_DOUBLE_EQ(values[0], 1.0 - mean);
+  EXPECT_DOUBLE_EQ(values[3], std::sqrt(3.0) * (5.0 - mean));
+  // Without weights, the plain mean.
+  double plain[6] = {1.0, 1.0, 1.0, 5.0, 5.0, 5.0};
+  internal::AgainstCameraMean(1, 2, Eigen::Vector3d::Ones(), plain);
+  EXPECT_DOUBLE_EQ(plain[0], -2.0);
+  EXPECT_DOUBLE_EQ(plain[3], 2.0);
+}
+
+// The cameras' weights follow their view cosines: given the same cosine in every camera they all
+// count alike, as without weights; given the scene's own, a steeper camera counts less and the
+// summaries change.
+TEST(PixelConsensusTest, CamerasCountByTheCosinesOfTheirViews) {
+  SampledScene scene = MakeSampledScene(0.001);
+  ConsensusOptions options = SampledOptions().consensus;
+  const Eigen::VectorXd k = RandomK(scene.surface.size(), 0.002, 13);
+  const auto summaries = [&](const ConsensusOptions& o) {
+    PixelConsensusSimilarity term(scene.samples, scene.cameras, o);
+    term.PrepareBlockSummaries(k);
+    std::vector<double> costs;
+    for (int b = 0; b < static_cast<int>(term.residual_blocks().size()); ++b) {
+      costs.push_back(term.BlockSummaryOf(b).squared_norm);
+    }
+    return costs;
+  };
+  ConsensusOptions alike = options;
+  alike.view_cosine_power = 0.0;
+  const std::vector<double> unweighted = summaries(alike);
+  const std::vector<double> weighted = summaries(options);
+  ASSERT_EQ(weighted.size(), unweighted.size());
+  ASSERT_GT(weighted.size(), 20u);
+  double largest_change = 0.0;
+  for (size_t b = 0; b < weighted.size(); ++b) {
+    largest_change = std::max(
+        largest_change, std::abs(weighted[b] - unweighted[b]) / std::max(unweighted[b], 1e-300));
+  }
+  EXPECT_GT(largest_change, 1e-3);
+  for (CameraInput& camera : scene.cameras) {
+    camera.view_cosines.assign(scene.surface.size(), 0.5);
+  }
+  const std::vector<double> equal_cosines = summaries(options);
+  for (size_t b = 0; b < weighted.size(); ++b) {
+    EXPECT_NEAR(equal_cosines[b], unweighted[b], 1e-12 * std::max(unweighted[b], 1.0))
+        << "block " << b;
+  }
+  scene.cameras[0].view_cosines.resize(3);
+  EXPECT_THROW(summaries(options), Error);
+}
+
 // The samples see the texture at the images' resolution: with every k the same, the similarity
 // is best where the textured plane truly is, within a small fraction of the vertex spacing.
 TEST(PixelConsensusTest, UniformDisplacementIsBestAtTheTruePlane) {
@@ -430,16 +526,19 @@ TEST(PixelConsensusTest, TheAppearanceIsOneMoreViewOfEachPatch) {
 // with every sample where the blend of its face's corners puts it.
 struct SurfaceTermScene {
   explicit SurfaceTermScene(double truth_offset, double weight = 1.0, bool pooled_gain = false,
-                            SurfacePatches through = SurfacePatches::kFaceCover)
+                            SurfacePatches through = SurfacePatches::kFaceCover,
+                            double view_cosine_power = 1.0)
       : scene(MakeSampledScene(truth_offset)),
-        options(Weighted(weight, pooled_gain, through)),
+        options(Weighted(weight, pooled_gain, through, view_cosine_power)),
         patches(scene.samples, scene.cameras, options),
         surface(patches, scene.samples, options) {}
-  static ConsensusOptions Weighted(double weight, bool pooled_gain, SurfacePatches through) {
+  static ConsensusOptions Weighted(double weight, bool pooled_gain, SurfacePatches through,
+                                   double view_cosine_power = 1.0) {
     ConsensusOptions options = SampledOptions().consensus;
     options.surface_weight = weight;
     options.surface_patches = through;
     options.gain_per_channel = !pooled_gain;
+    options.view_cosine_power = view_cosine_power;
     return options;
   }
   SampledScene scene;
@@ -646,8 +745,11 @@ INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, SurfaceRowsTest, testing::Bool(),
 
 // With every k the same the refined mesh is the input surface moved as a whole, as each patch
 // is: the two terms agree block by block, the surface term times its weight.
+// The term weighs a patch's cameras alike (ConsensusOptions::view_cosine_power weighs the
+// patches' only), so the two agree where the patches' cameras count alike too.
 TEST(SurfaceConsensusTest, WithEveryKTheSameItIsThePatchTermTimesItsWeight) {
-  SurfaceTermScene t(0.0012, /*weight=*/3.0);
+  SurfaceTermScene t(0.0012, /*weight=*/3.0, /*pooled_gain=*/false, SurfacePatches::kFaceCover,
+                     /*view_cosine_power=*/0.0);
   const Eigen::VectorXd k = Eigen::VectorXd::Constant(t.scene.surface.size(), 0.0007);
   std::vector<double> patch_costs, surface_costs;
   t.patches.BlockCosts(k, &patch_costs);

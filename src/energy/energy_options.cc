@@ -114,6 +114,11 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
                 "Consensus similarity with samples: standard deviation (pixels) of the blur of the "
                 "images the samples read.",
                 0.0, 8.0);
+    f.AddDouble("view_cosine_power", &ConsensusOptions::view_cosine_power,
+                "Consensus similarity with samples: a camera's squared residuals in a patch count "
+                "the cosine of its view angle at the surface to this power, relative to the "
+                "patch's other cameras (0: every camera alike).",
+                0.0, 8.0);
     f.AddDouble("surface_weight", &ConsensusOptions::surface_weight,
                 "Consensus similarity with samples: weight of a second term that compares the "
                 "refined mesh itself, each sample moved with the corners of its face, beside the "

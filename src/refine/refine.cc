@@ -312,15 +312,11 @@ PreparedFrame PrepareFrameAhead(const SequenceModel& model, const ReferenceColor
 
 namespace {
 
-// Per camera, which vertices of `frame.fine` the detail stage reads it for: the cameras that see
-// the surface the surface Gaussians found (`found`, smoothed as the patches' shape will be at
-// level 1, PatchAgreementTerm::EndOfPass, over the same reach at finer levels) within
-// VisibilityOptions::sample_view_angle_deg of its normals, by the geometry alone, and the
-// cameras that see the input surface most frontally.
-std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& frame,
-                                                         const Eigen::VectorXd& found,
-                                                         const FrameInput& input,
-                                                         const RefineOptions& options) {
+// The surface the detail stage starts from: `frame.fine` displaced by the surface Gaussians'
+// `found`, smoothed as the patches' shape will be at level 1 (PatchAgreementTerm::EndOfPass),
+// over the same reach at finer levels.
+Mesh FoundSurface(const PreparedFrame& frame, const Eigen::VectorXd& found,
+                  const RefineOptions& options) {
   const FrameEnergy& energy = *frame.energy;
   Eigen::MatrixXd shape = found;
   energy.regularizer().AverageOverNeighbours(
@@ -330,13 +326,25 @@ std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& fr
   for (size_t s = 0; s < ids.size(); ++s) {
     surface.vertices.col(ids[s]) += shape(s, 0) * frame.normals.col(ids[s]);
   }
+  return surface;
+}
+
+// Per camera, which vertices of `frame.fine` the detail stage reads it for: the cameras that see
+// `surface` (FoundSurface; `normals` its vertex normals) within
+// VisibilityOptions::sample_view_angle_deg of its normals, by the geometry alone, and the
+// cameras that see the input surface most frontally.
+std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& frame,
+                                                         const Mesh& surface,
+                                                         const Eigen::Matrix3Xd& normals,
+                                                         const FrameInput& input,
+                                                         const RefineOptions& options) {
   VisibilityOptions visibility = options.visibility;
   visibility.max_view_angle_deg = visibility.sample_view_angle_deg;
   visibility.fallback_view_angle_deg =
       std::max(visibility.fallback_view_angle_deg, visibility.sample_view_angle_deg);
   const int wanted = FallbackCamerasWanted(options);
-  std::vector<std::vector<unsigned char>> visible = ComputeFrameVisibility(
-      surface, ComputeVertexNormals(surface), input.cameras, visibility, wanted);
+  std::vector<std::vector<unsigned char>> visible =
+      ComputeFrameVisibility(surface, normals, input.cameras, visibility, wanted);
   // Where the input is far off (a visual hull) the found surface's normals, even smoothed, carry
   // the first stage's noise and may turn a patch away from the views that see it best; the views
   // that see the input surface most frontally are read as well (the temple: 0.654 -> 0.688
@@ -349,6 +357,18 @@ std::vector<std::vector<unsigned char>> DetailVisibility(const PreparedFrame& fr
   return visible;
 }
 
+// Per vertex of `ids`, the cosine of the angle between `camera`'s view ray to it and its normal.
+std::vector<double> ViewCosines(const Camera& camera, const Eigen::Matrix3Xd& vertices,
+                                const Eigen::Matrix3Xd& normals, const std::vector<int>& ids) {
+  std::vector<double> cosines;
+  cosines.reserve(ids.size());
+  const Eigen::Vector3d centre = camera.Center();
+  for (int v : ids) {
+    cosines.push_back(std::abs((centre - vertices.col(v)).normalized().dot(normals.col(v))));
+  }
+  return cosines;
+}
+
 }  // namespace
 
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
@@ -358,8 +378,10 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
   const ConsensusOptions& consensus = options.energy.consensus;
   Require(found.size() == frame->energy->num_parameters(), "PrepareDetailEnergy",
           "one displacement per surface Gaussian expected");
+  const Mesh found_surface = FoundSurface(*frame, found, options);
+  const Eigen::Matrix3Xd found_normals = ComputeVertexNormals(found_surface);
   const std::vector<std::vector<unsigned char>> visible =
-      DetailVisibility(*frame, found, input, options);
+      DetailVisibility(*frame, found_surface, found_normals, input, options);
   SurfaceGaussians surface = frame->energy->surface();
   frame->energy.reset();  // Its pair lists and tables are not needed any more.
   const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
@@ -375,6 +397,10 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     cameras[c].camera = input.cameras[c];
     for (int v : surface.vertex_ids) cameras[c].visible.push_back(visible[c][v]);
     cameras[c].samples_visible = SampleVisibility(samples, cameras[c].visible);
+    if (consensus.view_cosine_power != 0.0) {
+      cameras[c].view_cosines =
+          ViewCosines(input.cameras[c], found_surface.vertices, found_normals, surface.vertex_ids);
+    }
     if (!input.masks.empty()) {
       cameras[c].samples_on_foreground.assign(samples.size(), 1);
       KeepForeground(input.cameras[c], input.masks[c], samples.base, SampleReach(consensus),

@@ -47,6 +47,10 @@ struct CameraInput {
   // sample); empty when the camera has no mask. A sample off it is left out of the patches this
   // camera compares, not the whole patch (PixelConsensusSimilarity).
   std::vector<unsigned char> samples_on_foreground;
+  // With surface samples: per surface Gaussian (as `visible`), the cosine of the angle between
+  // the camera's view ray and the normal of the surface the detail stage starts from
+  // (ConsensusOptions::view_cosine_power); empty: that of the input surface, at the samples.
+  std::vector<double> view_cosines;
 };
 
 // Points of the surface about a pixel apart at which a similarity reads the images at their own

@@ -31,14 +31,27 @@ void NormaliseDerivative(int n, bool pooled, const double* z, const double* inve
 
 // Each member's values in a patch of n members seen by `num_cameras` cameras (laid out as
 // AgreementResiduals' colours) against the cameras' mean, times `weight` per channel, in place.
-void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values);
+// With `camera_weights` (one per camera, null: all 1) the mean is weighted by them and camera a's
+// values are also scaled by the root of its weight: its squared residuals count that many times.
+void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values,
+                       const double* camera_weights = nullptr);
 
 // Turns, in place, the colours of a patch of n members in `num_cameras` cameras (camera after
 // camera, member after member, channel after channel) and, when `jacobian` is not null, their
 // k-derivatives into the consensus residuals before the robust loss: each camera's colours
-// normalised (Normalise), then each against the cameras' mean, times `weight` per channel.
+// normalised (Normalise), then each against the cameras' mean, times `weight` per channel
+// (AgainstCameraMean, with `camera_weights` as there).
 void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
-                        const Eigen::Vector3d& weight, double* residuals, double* jacobian);
+                        const Eigen::Vector3d& weight, double* residuals, double* jacobian,
+                        const double* camera_weights = nullptr);
+
+// The summary (sum of squares and, when `derivatives` is not null, the sums with their
+// k-derivatives) of the residuals AgreementResiduals makes of `colors` and `derivatives`, without
+// writing them: one pass over the colours after each camera's normalisation, for the evaluations
+// that need no more than a block's summary.
+BlockSummary AgreementSummary(int n, int num_cameras, double floor, bool pooled,
+                              const Eigen::Vector3d& weight, const double* colors,
+                              const double* derivatives, const double* camera_weights = nullptr);
 
 // The per-channel root mean variance over its cameras of a patch's colours (laid out as above).
 Eigen::Vector3d PatchContrast(int n, int num_cameras, const double* colors);
@@ -121,13 +134,21 @@ class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
   // camera, member after member, channel after channel: the order of the block's residuals.
   virtual void PatchColors(int b, double k, double* colors, double* derivatives) const = 0;
 
-  // Adds the block of a patch moving with `parameter`: its members (its own first) and cameras.
-  void AddPatch(int parameter, const std::vector<int>& members, const std::vector<int>& cameras);
+  // Adds the block of a patch moving with `parameter`: its members (its own first) and cameras,
+  // and, when not empty, one weight per camera (any positive scale: they are taken relative to
+  // their mean). Without weights every camera of the block counts alike; a term gives either
+  // every block weights or none.
+  void AddPatch(int parameter, const std::vector<int>& members, const std::vector<int>& cameras,
+                const std::vector<double>& camera_weights = {});
   // Sets every block's weight from its colours at the input surface: call once every patch is
   // added and PatchColors can read them.
   void WeighPatches();
 
   const int* Cameras(int b) const { return &cameras_[camera_begin_[b]]; }
+  // Block b's cameras' weights, mean 1 (AddPatch), or null when every camera counts alike.
+  const double* CameraWeights(int b) const {
+    return camera_weights_.empty() ? nullptr : &camera_weights_[camera_begin_[b]];
+  }
   // Block b's summary (its derivative parts only when `with_derivatives`), with the robust loss
   // applied to the sums instead of to every residual: what the solvers and the sweep need.
   BlockSummary SummaryAt(int b, double k, bool with_derivatives) const;
@@ -145,6 +166,9 @@ class PatchAgreementTerm : public SummarisedDataTerm, public PassHook {
 
   // Block b's members are members_[patch_begin_[b] ..), its cameras cameras_[camera_begin_[b] ..).
   std::vector<int> patch_begin_ = {0}, members_, camera_begin_ = {0}, cameras_;
+  // Per entry of cameras_, that camera's weight in its block (CameraWeights); empty when every
+  // camera counts alike.
+  std::vector<double> camera_weights_;
   // PrepareResiduals' results; block b's residuals and derivatives from residual_begin_[b].
   std::vector<long> residual_begin_ = {0};
   std::vector<double> residuals_, jacobians_;

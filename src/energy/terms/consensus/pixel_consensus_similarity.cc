@@ -146,6 +146,8 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
             camera.camera.name, "the samples need the camera's image, converted (CV_32FC3)");
     Require(camera.samples_visible.size() == static_cast<size_t>(samples.size()),
             camera.camera.name, "visibility must have one flag per surface sample");
+    Require(camera.view_cosines.empty() || camera.view_cosines.size() == samples.patches.size(),
+            camera.camera.name, "view cosines must have one entry per surface Gaussian, or none");
     Require(camera.samples_on_foreground.empty() ||
                 camera.samples_on_foreground.size() == static_cast<size_t>(samples.size()),
             camera.camera.name, "the foreground must have one flag per surface sample, or none");
@@ -166,7 +168,8 @@ PixelConsensusSimilarity::PixelConsensusSimilarity(const SurfaceSamples& samples
     ComparablePart(patch, &seen_by, &members);
     if (seen_by.empty()) continue;
     if (AppearanceKnown(members)) seen_by.push_back(appearance_view_);
-    if (static_cast<int>(seen_by.size()) >= options_.min_cameras) AddPatch(s, members, seen_by);
+    if (static_cast<int>(seen_by.size()) < options_.min_cameras) continue;
+    AddPatch(s, members, seen_by, CameraWeightsOf(s, seen_by));
   }
   shape_ = Eigen::VectorXd::Zero(samples.size());
   parameter_shape_ = Eigen::VectorXd::Zero(samples.patches.size());
@@ -211,6 +214,30 @@ void PixelConsensusSimilarity::ComparablePart(const std::vector<int>& patch,
   for (int m = 0; m < size; ++m) {
     if (kept[m] != 0) members->push_back(patch[m]);
   }
+}
+
+std::vector<double> PixelConsensusSimilarity::CameraWeightsOf(
+    int patch, const std::vector<int>& seen_by) const {
+  const double power = options_.view_cosine_power;
+  if (power == 0.0) return {};
+  // A view at grazing incidence keeps a little weight: its cosine is only as exact as the normal.
+  constexpr double kMinCosine = 0.05;
+  const int own = samples_.patches[patch][0];
+  std::vector<double> weights;
+  for (int c : seen_by) {
+    // The appearance is the surface seen head-on, as the frame before's cameras averaged it.
+    double cosine = 1.0;
+    if (c != appearance_view_) {
+      const CameraInput& camera = cameras_[c];
+      cosine = !camera.view_cosines.empty()
+                   ? camera.view_cosines[patch]
+                   : std::abs((camera.camera.Center() - samples_.base.col(own))
+                                  .normalized()
+                                  .dot(samples_.normals.col(own)));
+    }
+    weights.push_back(std::pow(std::max(cosine, kMinCosine), power));
+  }
+  return weights;
 }
 
 bool PixelConsensusSimilarity::AppearanceKnown(const std::vector<int>& members) const {

@@ -18,7 +18,9 @@
 // k per surface Gaussian: the samples only read the images finer.
 //
 // A camera counts for a patch when it sees every sample of it (visibility of the input surface),
-// and a patch needs at least `min_cameras` such cameras. With ConsensusOptions::shared_appearance
+// and a patch needs at least `min_cameras` such cameras. Its squared residuals count cos^p of its
+// view angle relative to the patch's other cameras (ConsensusOptions::view_cosine_power): a steep
+// view sees the patch foreshortened. With ConsensusOptions::shared_appearance
 // and the samples' appearance (SurfaceSamples::appearance) known on all of a patch, that
 // appearance is one more view of the patch, normalised and compared as a camera's colours are
 // (it does not move with k): the surface's colours do not change from frame to frame while its
@@ -82,6 +84,9 @@ class PixelConsensusSimilarity : public PatchAgreementTerm {
 
   // Whether the patch's members all have a known appearance (SurfaceSamples::appearance).
   bool AppearanceKnown(const std::vector<int>& members) const;
+  // The weights of the cameras `seen_by` of `patch` (ConsensusOptions::view_cosine_power), at
+  // CameraInput::view_cosines or, without them, at the patch's own sample; none with power 0.
+  std::vector<double> CameraWeightsOf(int patch, const std::vector<int>& seen_by) const;
 
   const SurfaceSamples& samples_;
   const std::vector<CameraInput>& cameras_;
