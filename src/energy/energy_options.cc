@@ -115,9 +115,9 @@ const OptionFields<ConsensusOptions>& ConsensusOptions::Fields() {
                 "images the samples read.",
                 0.0, 8.0);
     f.AddDouble("view_cosine_power", &ConsensusOptions::view_cosine_power,
-                "Consensus similarity with samples: a camera's squared residuals in a patch count "
-                "the cosine of its view angle at the surface to this power, relative to the "
-                "patch's other cameras (0: every camera alike).",
+                "Consensus similarity: a camera's squared residuals in a patch count the cosine of "
+                "its view angle at the surface to this power, relative to the patch's other "
+                "cameras (0: every camera alike).",
                 0.0, 8.0);
     f.AddDouble("surface_weight", &ConsensusOptions::surface_weight,
                 "Consensus similarity with samples: weight of a second term that compares the "

@@ -105,7 +105,7 @@ std::vector<std::pair<double, int>> ViewsOf(const std::vector<Camera>& cameras,
   std::vector<std::pair<double, int>> views;
   for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
     if (!visible[c][p]) continue;
-    views.emplace_back(normal.dot((cameras[c].Center() - point).normalized()), c);
+    views.emplace_back(cameras[c].ViewCosine(point, normal), c);
   }
   std::sort(views.begin(), views.end(), std::greater<>());
   return views;

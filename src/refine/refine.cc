@@ -362,10 +362,7 @@ std::vector<double> ViewCosines(const Camera& camera, const Eigen::Matrix3Xd& ve
                                 const Eigen::Matrix3Xd& normals, const std::vector<int>& ids) {
   std::vector<double> cosines;
   cosines.reserve(ids.size());
-  const Eigen::Vector3d centre = camera.Center();
-  for (int v : ids) {
-    cosines.push_back(std::abs((centre - vertices.col(v)).normalized().dot(normals.col(v))));
-  }
+  for (int v : ids) cosines.push_back(camera.ViewCosine(vertices.col(v), normals.col(v)));
   return cosines;
 }
 

@@ -59,11 +59,12 @@ struct ConsensusOptions {
   double sample_spacing = 1.0;
   // The samples read the blurred images by bilinear interpolation.
   double sample_blur = 0.4;
-  // With samples: a camera that sees a patch at a steep angle sees its texture foreshortened,
-  // fewer of its pixels on it and its colours blurred across the tilt, and agrees less with the
-  // others at the right depth; its squared residuals in the patch count cos^p of its view angle,
-  // relative to the patch's other cameras (PatchAgreementTerm::AddPatch). p = 1 gained on every
-  // synthetic capture and both real ones (docs/measurements.md, 2026-12-06); 0: every camera alike.
+  // A camera that sees a patch at a steep angle sees its texture foreshortened, fewer of its
+  // pixels on it and its colours blurred across the tilt, and agrees less with the others at the
+  // right depth; its squared residuals in the patch count cos^p of its view angle, relative to
+  // the patch's other cameras (PatchAgreementTerm::AddPatch), in both stages. p = 1 gained on
+  // every synthetic capture and camera count (docs/measurements.md, 2026-12-06 (night)); 0: every
+  // camera alike.
   double view_cosine_power = 1.0;
   // With samples: the weight of the detail stage's second term, which compares the refined mesh
   // itself (each sample where the blend of its face's corners' k puts it;

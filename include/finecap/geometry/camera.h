@@ -39,6 +39,11 @@ struct Camera {
   // Camera centre in world coordinates, -R^T t.
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   Eigen::Vector3d ToCamera(const Eigen::Vector3d& world) const { return R * world + t; }
+  // The cosine of the angle between `normal` (unit) at world point `point` and the ray from it to
+  // the camera centre: 1 head-on, 0 at grazing incidence, negative facing away.
+  double ViewCosine(const Eigen::Vector3d& point, const Eigen::Vector3d& normal) const {
+    return normal.dot((Center() - point).normalized());
+  }
   // Depth of a world point along the optical axis.
   double Depth(const Eigen::Vector3d& world) const { return R.row(2).dot(world) + t(2); }
 

@@ -91,7 +91,7 @@ int MostFrontalCamera(const Eigen::Vector3d& point, const Eigen::Vector3d& norma
   double best_alignment = -std::numeric_limits<double>::infinity();
   for (int c = 0; c < static_cast<int>(cameras.size()); ++c) {
     if (!sees(c)) continue;
-    const double alignment = normal.dot((cameras[c].Center() - point).normalized());
+    const double alignment = cameras[c].ViewCosine(point, normal);
     if (alignment > best_alignment) {
       best_alignment = alignment;
       best = c;

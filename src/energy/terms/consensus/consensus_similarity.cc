@@ -130,7 +130,15 @@ ConsensusSimilarity::ConsensusSimilarity(const SurfaceGaussians& surface,
       for (int j : patch) rows.push_back(first_row_[c] + rows_of[c][j]);
     }
     if (static_cast<int>(cameras.size()) < options_.min_cameras) continue;
-    AddPatch(s, patch, cameras);
+    std::vector<double> camera_weights;
+    if (options_.view_cosine_power != 0.0) {
+      for (int c : cameras) {
+        camera_weights.push_back(internal::ViewWeight(
+            views[c].camera.ViewCosine(surface.base.col(s), surface.normals.col(s)),
+            options_.view_cosine_power));
+      }
+    }
+    AddPatch(s, patch, cameras, camera_weights);
     rows_.insert(rows_.end(), rows.begin(), rows.end());
     row_begin_.push_back(static_cast<long>(rows_.size()));
     max_block_rows_ = std::max(max_block_rows_, static_cast<int>(rows.size()));
@@ -411,16 +419,29 @@ void ConsensusSimilarity::UniformCostsOfBlock(int b, const double* lane_colors, 
     NormaliseLanes<kLanes>(n, options_.contrast_floor, !options_.gain_per_channel, rows + n * a,
                            lane_colors, scratch + stride * a);
   }
-  // PlainResiduals' against the mean, in place, then SummaryAt's sum in the residuals' order.
+  // PlainResiduals' against the (weighted) mean, in place, then the sum of their squares.
   const Eigen::Vector3d weight = scale_ * weights_[b];
+  const double* camera_weights = CameraWeights(b);
+  const auto camera_weight = [&](int a) {
+    return camera_weights != nullptr ? camera_weights[a] : 1.0;
+  };
+  thread_local std::vector<double> roots;  // Of the cameras' weights.
+  roots.resize(num_cameras);
+  double total_weight = 0.0;
+  for (int a = 0; a < num_cameras; ++a) {
+    roots[a] = std::sqrt(camera_weight(a));
+    total_weight += camera_weight(a);
+  }
   for (int m = 0; m < n; ++m) {
     for (int channel = 0; channel < 3; ++channel) {
       double* values = scratch + kLanes * (3 * m + channel);
       Lanes<kLanes> mean = Lanes<kLanes>::Zero();
-      for (int a = 0; a < num_cameras; ++a) mean += LanesAt<kLanes>(values + stride * a);
+      for (int a = 0; a < num_cameras; ++a) {
+        mean += camera_weight(a) * LanesAt<kLanes>(values + stride * a);
+      }
       for (int a = 0; a < num_cameras; ++a) {
         auto value = LanesAt<kLanes>(values + stride * a);
-        value = weight[channel] * (value - mean / num_cameras);
+        value = roots[a] * weight[channel] * (value - mean / total_weight);
       }
     }
   }

@@ -42,7 +42,9 @@
 //
 // Occlusion and silhouettes: a camera counts for a patch only when it sees every Gaussian of the
 // patch (visibility of the input surface), and a patch needs at least `min_cameras` such cameras;
-// a Gaussian seen by fewer has no data term and follows the regulariser.
+// a Gaussian seen by fewer has no data term and follows the regulariser. A camera's squared
+// residuals count cos^p of its view angle at the input surface, relative to the patch's other
+// cameras (ConsensusOptions::view_cosine_power): a steep view sees the patch foreshortened.
 #ifndef FINECAP_CONSENSUS_SIMILARITY_H_
 #define FINECAP_CONSENSUS_SIMILARITY_H_
 

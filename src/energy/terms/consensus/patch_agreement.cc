@@ -222,6 +222,12 @@ BlockSummary AgreementSummary(int n, int num_cameras, double floor, bool pooled,
   return summary;
 }
 
+double ViewWeight(double view_cosine, double power) {
+  // A view at grazing incidence keeps a little weight: its cosine is only as exact as the normal.
+  constexpr double kMinCosine = 0.05;
+  return power == 0.0 ? 1.0 : std::pow(std::max(std::abs(view_cosine), kMinCosine), power);
+}
+
 Eigen::Vector3d PatchContrast(int n, int num_cameras, const double* colors) {
   Eigen::Vector3d variance = Eigen::Vector3d::Zero();
   for (int a = 0; a < num_cameras; ++a) {

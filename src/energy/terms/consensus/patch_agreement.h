@@ -53,6 +53,11 @@ BlockSummary AgreementSummary(int n, int num_cameras, double floor, bool pooled,
                               const Eigen::Vector3d& weight, const double* colors,
                               const double* derivatives, const double* camera_weights = nullptr);
 
+// The weight of a camera in a patch it sees at `view_cosine` (Camera::ViewCosine at the patch's
+// vertex), before the patch's weights are taken relative to their mean:
+// ConsensusOptions::view_cosine_power of its absolute value, kept above a grazing view's.
+double ViewWeight(double view_cosine, double power);
+
 // The per-channel root mean variance over its cameras of a patch's colours (laid out as above).
 Eigen::Vector3d PatchContrast(int n, int num_cameras, const double* colors);
 

@@ -218,10 +218,7 @@ void PixelConsensusSimilarity::ComparablePart(const std::vector<int>& patch,
 
 std::vector<double> PixelConsensusSimilarity::CameraWeightsOf(
     int patch, const std::vector<int>& seen_by) const {
-  const double power = options_.view_cosine_power;
-  if (power == 0.0) return {};
-  // A view at grazing incidence keeps a little weight: its cosine is only as exact as the normal.
-  constexpr double kMinCosine = 0.05;
+  if (options_.view_cosine_power == 0.0) return {};
   const int own = samples_.patches[patch][0];
   std::vector<double> weights;
   for (int c : seen_by) {
@@ -231,11 +228,9 @@ std::vector<double> PixelConsensusSimilarity::CameraWeightsOf(
       const CameraInput& camera = cameras_[c];
       cosine = !camera.view_cosines.empty()
                    ? camera.view_cosines[patch]
-                   : std::abs((camera.camera.Center() - samples_.base.col(own))
-                                  .normalized()
-                                  .dot(samples_.normals.col(own)));
+                   : camera.camera.ViewCosine(samples_.base.col(own), samples_.normals.col(own));
     }
-    weights.push_back(std::pow(std::max(cosine, kMinCosine), power));
+    weights.push_back(internal::ViewWeight(cosine, options_.view_cosine_power));
   }
   return weights;
 }
