@@ -92,9 +92,9 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
 void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values,
                        const double* camera_weights) {
   const int stride = 3 * n;  // From one camera's patch to the next.
-  double total_weight = num_cameras;
-  if (camera_weights != nullptr)
-    total_weight = std::accumulate(camera_weights, camera_weights + num_cameras, 0.0);
+  const double total_weight =
+      camera_weights != nullptr ? std::accumulate(camera_weights, camera_weights + num_cameras, 0.0)
+                                : static_cast<double>(num_cameras);
   for (int m = 0; m < n; ++m) {
     double mean[3] = {0.0, 0.0, 0.0};
     for (int a = 0; a < num_cameras; ++a) {
