@@ -184,10 +184,9 @@ class ConsensusUniformCostsTest : public ::testing::TestWithParam<UniformCostsCa
 // The consensus similarity reduces each block to its cost at the sweep's uniform displacements
 // without writing its residuals, several displacements at a time. Each cost must be the one the
 // residual path gives, to rounding: that of SummaryAt (which BlockCosts takes when k is not
-// uniform; a block depends on its centre's k alone, and SummaryAt sums without writing the
-// residuals either, in another order), and the sum of squares of the residuals PrepareResiduals
-// writes (the robust loss applied to each). With a patch shape set,
-// the costs come from the residual path itself.
+// uniform; a block depends on its centre's k alone), and the sum of squares of the residuals
+// PrepareResiduals writes (the robust loss applied to each). With a patch shape set, the costs come
+// from the residual path itself.
 TEST_P(ConsensusUniformCostsTest, CostsAreThoseOfTheResidualPath) {
   const UniformCostsCase variant = GetParam();
   EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);

@@ -256,8 +256,8 @@ TEST(PixelConsensusTest, ScalarIsMinusHalfTheSumOfTheBlockCosts) {
   EXPECT_NEAR(term.Evaluate(k, nullptr), -0.5 * sum, 1e-12 * sum);
 }
 
-// A block's summary is formed from its colours without writing its residuals: it must be the
-// summary of those residuals (sum of squares, <r, dr/dk>, |dr/dk|^2), with and without the robust
+// A block's summary (SummaryAt, what the solvers read) must be the summary of the residuals
+// PrepareResiduals writes (sum of squares, <r, dr/dk>, |dr/dk|^2), with and without the robust
 // loss, with one gain per camera or one per channel.
 class SummaryOfResidualsTest : public testing::TestWithParam<std::tuple<double, bool>> {};
 

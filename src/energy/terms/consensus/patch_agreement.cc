@@ -124,104 +124,6 @@ void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
   if (jacobian != nullptr) AgainstCameraMean(n, num_cameras, weight, jacobian, camera_weights);
 }
 
-namespace {
-
-// What one camera's normalisation (Normalise) of a patch's colours q and derivatives dq takes:
-// per channel the mean of q and of dq, the inverse deviation and <z, dq/dk>, so that
-// z = (q - mean) inverse_deviation and dz/dk = (dq - mean_derivative - z z_dot_dq)
-// inverse_deviation can be formed where they are used.
-struct CameraNormalisation {
-  double mean[3] = {0.0, 0.0, 0.0}, inverse_deviation[3] = {0.0, 0.0, 0.0};
-  double mean_derivative[3] = {0.0, 0.0, 0.0}, z_dot_dq[3] = {0.0, 0.0, 0.0};
-
-  CameraNormalisation(int n, double floor, bool pooled, const double* q, const double* dq) {
-    double variance[3] = {0.0, 0.0, 0.0}, centred_dot_dq[3] = {0.0, 0.0, 0.0};
-    for (int m = 0; m < n; ++m) {
-      for (int channel = 0; channel < 3; ++channel) {
-        mean[channel] += q[3 * m + channel];
-        if (dq != nullptr) mean_derivative[channel] += dq[3 * m + channel];
-      }
-    }
-    for (int channel = 0; channel < 3; ++channel) {
-      mean[channel] /= n;
-      mean_derivative[channel] /= n;
-    }
-    for (int m = 0; m < n; ++m) {
-      for (int channel = 0; channel < 3; ++channel) {
-        const double centred = q[3 * m + channel] - mean[channel];
-        variance[channel] += centred * centred;
-        if (dq != nullptr) centred_dot_dq[channel] += centred * dq[3 * m + channel];
-      }
-    }
-    for (double& value : variance) value /= n;
-    if (pooled) std::fill_n(variance, 3, (variance[0] + variance[1] + variance[2]) / 3.0);
-    for (int channel = 0; channel < 3; ++channel) {
-      inverse_deviation[channel] = 1.0 / std::sqrt(variance[channel] + floor * floor);
-      z_dot_dq[channel] = inverse_deviation[channel] * centred_dot_dq[channel] / n;
-    }
-    if (pooled) std::fill_n(z_dot_dq, 3, (z_dot_dq[0] + z_dot_dq[1] + z_dot_dq[2]) / 3.0);
-  }
-};
-
-}  // namespace
-
-BlockSummary AgreementSummary(int n, int num_cameras, double floor, bool pooled,
-                              const Eigen::Vector3d& weight, const double* colors,
-                              const double* derivatives, const double* camera_weights) {
-  const int stride = 3 * n;  // From one camera's patch to the next.
-  thread_local std::vector<CameraNormalisation> cameras;
-  cameras.clear();
-  for (int a = 0; a < num_cameras; ++a) {
-    cameras.emplace_back(n, floor, pooled, colors + stride * a,
-                         derivatives != nullptr ? derivatives + stride * a : nullptr);
-  }
-  // Per member and channel, the cameras' z and dz/dk about their (weighted) mean, each squared
-  // difference counted with its camera's weight: r = root(w_a) w (z - mean_a z).
-  thread_local std::vector<double> z, dz;
-  z.resize(num_cameras);
-  dz.resize(num_cameras);
-  const auto camera_weight = [&](int a) {
-    return camera_weights != nullptr ? camera_weights[a] : 1.0;
-  };
-  double total_weight = 0.0;
-  for (int a = 0; a < num_cameras; ++a) total_weight += camera_weight(a);
-  double squared_norm[3] = {0.0, 0.0, 0.0}, gradient[3] = {0.0, 0.0, 0.0};
-  double curvature[3] = {0.0, 0.0, 0.0};
-  for (int m = 0; m < n; ++m) {
-    for (int channel = 0; channel < 3; ++channel) {
-      const int i = 3 * m + channel;
-      double z_sum = 0.0, dz_sum = 0.0;
-      for (int a = 0; a < num_cameras; ++a) {
-        const CameraNormalisation& camera = cameras[a];
-        z[a] = (colors[stride * a + i] - camera.mean[channel]) * camera.inverse_deviation[channel];
-        z_sum += camera_weight(a) * z[a];
-        if (derivatives == nullptr) continue;
-        dz[a] = (derivatives[stride * a + i] - camera.mean_derivative[channel] -
-                 z[a] * camera.z_dot_dq[channel]) *
-                camera.inverse_deviation[channel];
-        dz_sum += camera_weight(a) * dz[a];
-      }
-      const double z_mean = z_sum / total_weight, dz_mean = dz_sum / total_weight;
-      for (int a = 0; a < num_cameras; ++a) {
-        const double r = z[a] - z_mean;
-        squared_norm[channel] += camera_weight(a) * r * r;
-        if (derivatives == nullptr) continue;
-        const double dr = dz[a] - dz_mean;
-        gradient[channel] += camera_weight(a) * r * dr;
-        curvature[channel] += camera_weight(a) * dr * dr;
-      }
-    }
-  }
-  BlockSummary summary;
-  for (int channel = 0; channel < 3; ++channel) {
-    const double w2 = weight[channel] * weight[channel];
-    summary.squared_norm += w2 * squared_norm[channel];
-    summary.gradient += w2 * gradient[channel];
-    summary.curvature += w2 * curvature[channel];
-  }
-  return summary;
-}
-
 double ViewWeight(double view_cosine, double power) {
   // A view at grazing incidence keeps a little weight: its cosine is only as exact as the normal.
   constexpr double kMinCosine = 0.05;
@@ -362,15 +264,17 @@ double PatchAgreementTerm::LossScale(int b) const {
 }
 
 BlockSummary PatchAgreementTerm::SummaryAt(int b, double k, bool with_derivatives) const {
-  thread_local std::vector<double> colors, derivatives;
+  thread_local std::vector<double> residuals, jacobian;
   const int num_residuals = blocks_[b].num_residuals;
-  colors.resize(num_residuals);
-  derivatives.resize(with_derivatives ? num_residuals : 0);
-  double* dq = with_derivatives ? derivatives.data() : nullptr;
-  PatchColors(b, k, colors.data(), dq);
-  const BlockSummary plain = internal::AgreementSummary(
-      PatchSize(b), NumCameras(b), options_.contrast_floor, !options_.gain_per_channel,
-      ResidualWeight(b), colors.data(), dq, CameraWeights(b));
+  residuals.resize(num_residuals);
+  jacobian.resize(with_derivatives ? num_residuals : 0);
+  PlainResiduals(b, k, residuals.data(), with_derivatives ? jacobian.data() : nullptr);
+  BlockSummary plain;
+  if (with_derivatives) {
+    plain = Summarise(residuals.data(), jacobian.data(), num_residuals);
+  } else {
+    for (int r = 0; r < num_residuals; ++r) plain.squared_norm += residuals[r] * residuals[r];
+  }
   return internal::Robustify(LossScale(b), plain, with_derivatives);
 }
 

@@ -45,14 +45,6 @@ void AgreementResiduals(int n, int num_cameras, double floor, bool pooled,
                         const Eigen::Vector3d& weight, double* residuals, double* jacobian,
                         const double* camera_weights = nullptr);
 
-// The summary (sum of squares and, when `derivatives` is not null, the sums with their
-// k-derivatives) of the residuals AgreementResiduals makes of `colors` and `derivatives`, without
-// writing them: one pass over the colours after each camera's normalisation, for the evaluations
-// that need no more than a block's summary.
-BlockSummary AgreementSummary(int n, int num_cameras, double floor, bool pooled,
-                              const Eigen::Vector3d& weight, const double* colors,
-                              const double* derivatives, const double* camera_weights = nullptr);
-
 // The weight of a camera in a patch it sees at `view_cosine` (Camera::ViewCosine at the patch's
 // vertex), before the patch's weights are taken relative to their mean:
 // ConsensusOptions::view_cosine_power of its absolute value, kept above a grazing view's.
