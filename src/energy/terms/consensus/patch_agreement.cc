@@ -92,21 +92,34 @@ void Normalise(int n, double floor, bool pooled, double* q, double* dq) {
 void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, double* values,
                        const double* camera_weights) {
   const int stride = 3 * n;  // From one camera's patch to the next.
+  // Per camera, its share of the mean and the factor of its values, once per patch rather than
+  // once per member: a patch of samples has tens of members.
+  thread_local std::vector<double> share, scale;
+  share.resize(num_cameras);
+  scale.resize(3 * num_cameras);
   const double total_weight =
       camera_weights != nullptr ? std::accumulate(camera_weights, camera_weights + num_cameras, 0.0)
                                 : static_cast<double>(num_cameras);
-  for (int m = 0; m < n; ++m) {
-    double mean[3] = {0.0, 0.0, 0.0};
-    for (int a = 0; a < num_cameras; ++a) {
-      const double camera_weight = camera_weights != nullptr ? camera_weights[a] : 1.0;
-      for (int channel = 0; channel < 3; ++channel)
-        mean[channel] += camera_weight * values[stride * a + 3 * m + channel];
-    }
-    for (int a = 0; a < num_cameras; ++a) {
-      const double root = camera_weights != nullptr ? std::sqrt(camera_weights[a]) : 1.0;
+  for (int a = 0; a < num_cameras; ++a) {
+    const double camera_weight = camera_weights != nullptr ? camera_weights[a] : 1.0;
+    share[a] = camera_weight / total_weight;
+    const double root = camera_weights != nullptr ? std::sqrt(camera_weight) : 1.0;
+    for (int channel = 0; channel < 3; ++channel) scale[3 * a + channel] = root * weight[channel];
+  }
+  // Camera after camera, so that both loops run over contiguous values.
+  thread_local std::vector<double> mean;
+  mean.assign(stride, 0.0);
+  for (int a = 0; a < num_cameras; ++a) {
+    const double* camera_values = values + stride * a;
+    for (int i = 0; i < stride; ++i) mean[i] += share[a] * camera_values[i];
+  }
+  for (int a = 0; a < num_cameras; ++a) {
+    double* camera_values = values + stride * a;
+    const double* camera_scale = &scale[3 * a];
+    for (int m = 0; m < n; ++m) {
       for (int channel = 0; channel < 3; ++channel) {
-        double& value = values[stride * a + 3 * m + channel];
-        value = root * weight[channel] * (value - mean[channel] / total_weight);
+        const int i = 3 * m + channel;
+        camera_values[i] = camera_scale[channel] * (camera_values[i] - mean[i]);
       }
     }
   }
