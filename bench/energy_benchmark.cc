@@ -161,6 +161,7 @@ void BM_DetailSurfaceRows(benchmark::State& state) {
   PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
   PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  frame.energy->StartLastPass();
   DataTerm& surface = frame.energy->data_term(1);
   omp_set_num_threads(threads);
   for (auto _ : state) surface.PrepareResiduals(k, /*with_jacobians=*/true);

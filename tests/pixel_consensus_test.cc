@@ -547,12 +547,14 @@ struct SurfaceTermScene {
   SurfaceConsensusSimilarity surface;
 };
 
-TEST(SurfaceConsensusTest, TheDetailStageSumsItWithThePatchesWhenItHasAWeight) {
+// From the solver's last pass on: the passes before it only shape the patches of the next.
+TEST(SurfaceConsensusTest, TheDetailStageSumsItWithThePatchesInTheLastPassWhenItHasAWeight) {
   const SampledScene scene = MakeSampledScene(0.001);
   EnergyOptions options = SampledOptions();
   options.consensus.surface_weight = 1.0;
-  const FrameEnergy both(scene.surface, scene.cameras, scene.neighbourhoods, options,
-                         scene.samples);
+  FrameEnergy both(scene.surface, scene.cameras, scene.neighbourhoods, options, scene.samples);
+  ASSERT_EQ(both.num_data_terms(), 1);
+  both.StartLastPass();
   ASSERT_EQ(both.num_data_terms(), 2);
   EXPECT_EQ(both.data_term(0).residual_blocks()[0].parameters.size(), 1u);
   size_t widest = 0;
@@ -561,8 +563,8 @@ TEST(SurfaceConsensusTest, TheDetailStageSumsItWithThePatchesWhenItHasAWeight) {
   }
   EXPECT_EQ(widest, 7u);  // An inner vertex of the grid and its six neighbours.
   options.consensus.surface_weight = 0.0;
-  const FrameEnergy patches(scene.surface, scene.cameras, scene.neighbourhoods, options,
-                            scene.samples);
+  FrameEnergy patches(scene.surface, scene.cameras, scene.neighbourhoods, options, scene.samples);
+  patches.StartLastPass();
   EXPECT_EQ(patches.num_data_terms(), 1);
 }
 

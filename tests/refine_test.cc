@@ -132,12 +132,16 @@ TEST_F(RefineFrameTest, TheDetailStageReadsTheCamerasWithinItsOwnAngle) {
 }
 
 // With energy.consensus.surface_weight the detail stage compares the refined mesh itself beside
-// the patches: its energy has the second term, the solve ends above where it started, and the
-// surface differs from the patches' alone.
-TEST_F(RefineFrameTest, TheRefinedMeshTermJoinsTheDetailStage) {
+// the patches in its last pass: its energy has the second term then, the solve ends above where
+// it started, and the surface differs from the patches' alone, with two passes as with one (whose
+// only pass is the last).
+class RefinedMeshTermTest : public RefineFrameTest, public testing::WithParamInterface<int> {};
+
+TEST_P(RefinedMeshTermTest, JoinsTheDetailStagesLastPass) {
   Capture capture = Capture::Open(*directory_);
   RefineOptions options;
   options.solver.max_iterations = 5;
+  options.energy.consensus.passes = GetParam();
   const FrameInput input = ReadFrameInput(&capture, 0);
   const SequenceModel model(input.coarse, {}, options, "test");
   const ReferenceColors colors = ComputeSequenceColors(model, input, options);
@@ -152,9 +156,13 @@ TEST_F(RefineFrameTest, TheRefinedMeshTermJoinsTheDetailStage) {
 
   PreparedFrame frame = PrepareFrame(model, colors, input, options);
   PrepareDetailEnergy(model, input, options, both.k_solved, &frame);
+  ASSERT_EQ(frame.energy->num_data_terms(), 1);
+  frame.energy->StartLastPass();
   ASSERT_EQ(frame.energy->num_data_terms(), 2);
   EXPECT_GT(frame.energy->data_term(1).residual_blocks().front().parameters.size(), 1u);
 }
+
+INSTANTIATE_TEST_SUITE_P(Passes, RefinedMeshTermTest, testing::Values(1, 2));
 
 // The plane sweep sets the range a frame is solved in from what it finds: a range far narrower
 // than the input's error limits many Gaussians and widens, one far wider than it holds almost

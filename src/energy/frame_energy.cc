@@ -53,9 +53,11 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
       sample_cameras_(samples_.size() > 0 ? cameras : std::vector<CameraInput>()),
       views_(BuildViews(surface_, cameras, options_, samples_.size() > 0)),
       regularizer_(neighbourhoods, surface_.vertex_ids, options_.reg_rings,
-                   options_.RegUnitScale()),
-      data_terms_(internal::MakeDataTerms(
-          {surface_, views_, neighbourhoods, regularizer_, samples_, sample_cameras_, options_})) {
+                   options_.RegUnitScale()) {
+  internal::DataTerms terms = internal::MakeDataTerms(
+      {surface_, views_, neighbourhoods, regularizer_, samples_, sample_cameras_, options_});
+  data_terms_ = std::move(terms.from_first_pass);
+  last_pass_terms_ = std::move(terms.from_last_pass);
   confidence_ = Confidence(surface_, PlainCloth(surface_, regularizer_, options_));
   const TermContext context{surface_, options_, regularizer_, confidence_,
                             [this] { return TypicalDataCurvature(); }};
@@ -89,6 +91,11 @@ Eigen::VectorXd FrameEnergy::UnknownsAtVertices(const Eigen::VectorXd& per_verte
   Eigen::VectorXd unknowns(static_cast<Eigen::Index>(ids.size()));
   for (size_t s = 0; s < ids.size(); ++s) unknowns[s] = per_vertex[ids[s]];
   return unknowns;
+}
+
+void FrameEnergy::StartLastPass() {
+  for (auto& term : last_pass_terms_) data_terms_.push_back(std::move(term));
+  last_pass_terms_.clear();
 }
 
 void FrameEnergy::AddDataTerm(std::unique_ptr<DataTerm> term) {

@@ -50,8 +50,10 @@ std::unique_ptr<DataTerm> MakeSimilarity(const DataTermContext& context) {
 }
 
 // The detail stage's terms, which read the surface samples: the patches moved as wholes and,
-// with a weight, the refined mesh itself read through the same patches.
-std::vector<std::unique_ptr<DataTerm>> SampledTerms(const DataTermContext& context) {
+// with a weight, from the last pass on, the refined mesh itself read through the same patches.
+// The earlier passes' results only shape the next pass's patches; the mesh that is handed back
+// is the last pass's, and comparing it costs as much as the patches do.
+DataTerms SampledTerms(const DataTermContext& context) {
   const ConsensusOptions& options = context.options.consensus;
   Require(context.options.similarity == SimilarityType::kConsensus, "energy.similarity",
           "surface samples (energy.consensus.sample_spacing) need the consensus similarity");
@@ -60,10 +62,10 @@ std::vector<std::unique_ptr<DataTerm>> SampledTerms(const DataTermContext& conte
   patches->SmoothShapesOver(&context.neighbours);
   // The surface term reads through the patches; both live as long as the energy.
   const PixelConsensusSimilarity& read_through = *patches;
-  std::vector<std::unique_ptr<DataTerm>> terms;
-  terms.push_back(std::move(patches));
+  DataTerms terms;
+  terms.from_first_pass.push_back(std::move(patches));
   if (options.surface_weight > 0.0) {
-    terms.push_back(
+    terms.from_last_pass.push_back(
         std::make_unique<SurfaceConsensusSimilarity>(read_through, context.samples, options));
   }
   return terms;
@@ -71,10 +73,10 @@ std::vector<std::unique_ptr<DataTerm>> SampledTerms(const DataTermContext& conte
 
 }  // namespace
 
-std::vector<std::unique_ptr<DataTerm>> MakeDataTerms(const DataTermContext& context) {
+DataTerms MakeDataTerms(const DataTermContext& context) {
   if (context.samples.size() > 0) return SampledTerms(context);
-  std::vector<std::unique_ptr<DataTerm>> terms;
-  terms.push_back(MakeSimilarity(context));
+  DataTerms terms;
+  terms.from_first_pass.push_back(MakeSimilarity(context));
   return terms;
 }
 

@@ -28,9 +28,16 @@ struct DataTermContext {
   const EnergyOptions& options;
 };
 
-// The data terms the options ask for, in the order they are summed: today the similarity of
-// options.similarity over the views or, with samples, over the cameras' pixels at the samples.
-std::vector<std::unique_ptr<DataTerm>> MakeDataTerms(const DataTermContext& context);
+// The data terms the options ask for, in the order they are summed.
+struct DataTerms {
+  // Summed from the first pass of the solver: the similarity of options.similarity over the
+  // views or, with samples, over the cameras' pixels at the samples.
+  std::vector<std::unique_ptr<DataTerm>> from_first_pass;
+  // Summed from the last pass on (FrameEnergy::StartLastPass): the refined mesh read itself
+  // (ConsensusOptions::surface_weight), which only the pass whose result is handed back needs.
+  std::vector<std::unique_ptr<DataTerm>> from_last_pass;
+};
+DataTerms MakeDataTerms(const DataTermContext& context);
 
 // The quadratic terms the options ask for, in the order their pulls are gathered.
 std::vector<std::unique_ptr<QuadraticTerm>> MakeQuadraticTerms(const TermContext& context);

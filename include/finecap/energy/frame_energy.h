@@ -110,7 +110,8 @@ class FrameEnergy {
   // (ReadsPairLists): the image models may then go.
   const std::vector<EnergyView>& views() const { return views_; }
 
-  // The data terms, summed in this order.
+  // The data terms, summed in this order: those of every pass of the solver and, after
+  // StartLastPass, those of its last pass.
   int num_data_terms() const { return static_cast<int>(data_terms_.size()); }
   DataTerm& data_term(int i) { return *data_terms_[i]; }
   const DataTerm& data_term(int i) const { return *data_terms_[i]; }
@@ -118,6 +119,11 @@ class FrameEnergy {
   // typical_data_curvature) keep the measure taken of the terms the energy was built with, and
   // the pair lists stay as they are.
   void AddDataTerm(std::unique_ptr<DataTerm> term);
+  // Adds to the sum the terms that only the solver's last pass needs (today the refined mesh's
+  // own term of the detail stage, ConsensusOptions::surface_weight); nothing after the first
+  // call. The structure of the residual blocks changes, so a solver builds its problem anew. As
+  // with AddDataTerm, the pulls keep the units measured of the terms the energy started with.
+  void StartLastPass();
   // Whether every data term is least-squares (DataTerm::IsLeastSquares): then E is minus the
   // least-squares cost, E_data's half sum of squares plus E_quad.
   bool IsLeastSquares() const;
@@ -169,6 +175,9 @@ class FrameEnergy {
   std::vector<EnergyView> views_;
   Regularizer regularizer_;  // Before the data terms: a term may read it.
   std::vector<std::unique_ptr<DataTerm>> data_terms_;
+  // Built with the others, summed from StartLastPass on. Declared after data_terms_, so freed
+  // first: a term here may read one there.
+  std::vector<std::unique_ptr<DataTerm>> last_pass_terms_;
   Eigen::VectorXd confidence_;
   std::vector<std::unique_ptr<QuadraticTerm>> quadratic_terms_;
   Pulls pulls_;
