@@ -142,6 +142,7 @@ TEST_P(RefinedMeshTermTest, JoinsTheDetailStagesLastPass) {
   RefineOptions options;
   options.solver.max_iterations = 5;
   options.energy.consensus.passes = GetParam();
+  options.energy.consensus.surface_weight = 0.0;
   const FrameInput input = ReadFrameInput(&capture, 0);
   const SequenceModel model(input.coarse, {}, options, "test");
   const ReferenceColors colors = ComputeSequenceColors(model, input, options);

@@ -71,7 +71,7 @@ struct ConsensusOptions {
   // SurfaceConsensusSimilarity), beside the patches moved as wholes; 0: the patches alone. 1
   // gains on every capture measured and makes level 2 beat level 1 on both real captures, but
   // takes 1.6 times a frame's time (docs/measurements.md, 2026-12-06), so it is off by default.
-  double surface_weight = 0.0;
+  double surface_weight = 1.0;
   // Every face lies in the patches of its three corners; kFaceCover compares it in one of them
   // (SurfaceConsensusSimilarity).
   SurfacePatches surface_patches = SurfacePatches::kFaceCover;
