@@ -420,10 +420,10 @@ namespace {
 
 // Solve, and for an energy whose terms change between passes (PassHook: the consensus' patches
 // shaped like the surface found so far) the further passes, the last with the terms that only it
-// needs (FrameEnergy::StartLastPass). With `measure_ends`, the summary's
-// start values are those of the last pass's energy at `*k`'s start, so that `worse` compares the
-// frame by the energy it ended with; without, a caller that only adds up the work or measures
-// the ends itself saves the two evaluations (a detail stage's cost as much as a solver's step).
+// needs (FrameEnergy::StartLastPass). With `measure_ends`, the summary's start values are those
+// of the last pass's energy at `*k`'s start, so that `worse` compares the frame by the energy it
+// ended with; without, a caller that only adds up the work or measures the ends itself saves the
+// two evaluations (a detail stage's cost as much as a solver's step).
 SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options,
                                Eigen::VectorXd* k, bool measure_ends,
                                SolverWorkspace* workspace = nullptr) {
@@ -431,12 +431,15 @@ SolverSummary SolveFrameEnergy(FrameEnergy* energy, const RefineOptions& options
   const Eigen::VectorXd start = *k;
   // One Ceres problem for the passes, built anew only when the last pass adds terms.
   FrameSolver solver(energy, options.solver, workspace);
-  if (passes == 1) energy->StartLastPass();
-  SolverSummary summary = solver.Solve(k);
-  for (int pass = 1; pass < passes; ++pass) {
-    energy->EndOfPass(*k);
+  SolverSummary summary;
+  for (int pass = 0; pass < passes; ++pass) {
+    if (pass > 0) energy->EndOfPass(*k);
     if (pass == passes - 1) energy->StartLastPass();
     const SolverSummary more = solver.Solve(k);
+    if (pass == 0) {
+      summary = more;
+      continue;
+    }
     summary.energy_end = more.energy_end;
     summary.ls_cost_end = more.ls_cost_end;
     summary.AddWork(more);

@@ -68,9 +68,10 @@ struct ConsensusOptions {
   double view_cosine_power = 1.0;
   // With samples: the weight of the detail stage's second term, which compares the refined mesh
   // itself (each sample where the blend of its face's corners' k puts it;
-  // SurfaceConsensusSimilarity), beside the patches moved as wholes; 0: the patches alone. 1
-  // gains on every capture measured and makes level 2 beat level 1 on both real captures, but
-  // takes 1.6 times a frame's time (docs/measurements.md, 2026-12-06), so it is off by default.
+  // SurfaceConsensusSimilarity), beside the patches moved as wholes, in the detail stage's last
+  // pass; 0: the patches alone. 1 gains on every capture and camera count measured and makes
+  // level 2 beat level 1 on both real captures, at 1.1-1.3 times a frame's time
+  // (docs/measurements.md, 2026-12-06 (late night)).
   double surface_weight = 1.0;
   // Every face lies in the patches of its three corners; kFaceCover compares it in one of them
   // (SurfaceConsensusSimilarity).

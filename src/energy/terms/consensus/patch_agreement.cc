@@ -103,7 +103,7 @@ void AgainstCameraMean(int n, int num_cameras, const Eigen::Vector3d& weight, do
   for (int a = 0; a < num_cameras; ++a) {
     const double camera_weight = camera_weights != nullptr ? camera_weights[a] : 1.0;
     share[a] = camera_weight / total_weight;
-    const double root = camera_weights != nullptr ? std::sqrt(camera_weight) : 1.0;
+    const double root = std::sqrt(camera_weight);  // Exactly 1 for a camera of weight 1.
     for (int channel = 0; channel < 3; ++channel) scale[3 * a + channel] = root * weight[channel];
   }
   // Camera after camera, so that both loops run over contiguous values.
