@@ -13,6 +13,8 @@
 #include "energy/terms/consensus/surface_consensus_similarity.h"
 #include "energy_fixture.h"
 #include "finecap/energy/frame_energy.h"
+#include "finecap/geometry/mesh_edges.h"
+#include "finecap/geometry/subdivision.h"
 #include "finecap/util/error.h"
 #include "refine/surface_sampling.h"
 
@@ -45,7 +47,7 @@ cv::Mat RenderPlane(const Camera& camera, double z_plane) {
   return image;
 }
 
-// A flat grid 1 m in front of three cameras, sampled two levels finer than its vertices, the
+// A flat grid 1 m in front of three cameras, its faces split into 4 x 4 for the samples, the
 // cameras' images showing the textured plane `truth_offset` metres along the grid's normal.
 struct SampledScene {
   Mesh mesh;
@@ -55,7 +57,7 @@ struct SampledScene {
   std::vector<CameraInput> cameras;
 };
 
-SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
+SampledScene MakeSampledScene(double truth_offset, int segments = 4) {
   SampledScene scene;
   scene.mesh = GridMesh(7, 7, 0.01, /*curvature=*/0.0);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(scene.mesh);
@@ -68,7 +70,7 @@ SampledScene MakeSampledScene(double truth_offset, int levels = 2) {
   scene.surface = MakeSurfaceGaussians(scene.mesh.vertices, normals, ids, colors);
   scene.neighbourhoods = BuildVertexNeighbourhoods(scene.mesh, 2);
   scene.samples = SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods,
-                                /*patch_rings=*/1, levels);
+                                /*patch_rings=*/1, segments);
   // The grid's normals point to -z, at the cameras: k moves the surface to z = -k.
   const double z_plane = -truth_offset;
   for (double tilt : {0.0, 0.35, -0.3}) {
@@ -129,17 +131,58 @@ TEST(SurfaceSamplingTest, SamplesKeepTheVerticesAndBlendTheirCorners) {
     EXPECT_LE(corners, 3);
     EXPECT_NEAR(scene.samples.base(2, j), 0.0, 1e-15);
   }
-  // An interior vertex's patch: the samples of its six faces, two levels finer (4 sample steps
+  // An interior vertex's patch: the samples of its six faces, split 4 a side (4 sample steps
   // per edge), that have a weight on it: the hexagon of radius 4 without its rim, 1 + 3 * 3 * 4.
   const int interior = 3 * 7 + 3;
   EXPECT_EQ(scene.samples.patches[interior].size(), 37u);
+}
+
+// Any count a side: each edge's inside points once, shared by its faces, each face's inside
+// points once, every point at its barycentric grid position.
+TEST(SurfaceSamplingTest, FacesSplitIntoAnyNumberOfSegments) {
+  const Mesh grid = GridMesh(4, 3, 0.01, /*curvature=*/0.0);
+  const MeshEdges edges = BuildMeshEdges(grid.faces);
+  for (int n : {1, 3, 5}) {
+    const Eigen::SparseMatrix<double> split = SplitFaces(grid, n);
+    const long expected = grid.num_vertices() + long(edges.num_edges()) * (n - 1) +
+                          long(grid.num_faces()) * (n - 1) * (n - 2) / 2;
+    ASSERT_EQ(split.rows(), expected) << n << " segments";
+    const Eigen::Matrix3Xd points = grid.vertices * split.transpose();
+    // No two points at the same place: a shared edge's points are not repeated.
+    for (int a = 0; a < points.cols(); ++a) {
+      for (int b = a + 1; b < points.cols(); ++b) {
+        ASSERT_GT((points.col(a) - points.col(b)).norm(), 1e-9) << n << " segments";
+      }
+    }
+    // The point nearest each face's centroid is its centre when n is a multiple of 3.
+    if (n % 3 != 0) continue;
+    for (int f = 0; f < grid.num_faces(); ++f) {
+      const Eigen::Vector3d centroid =
+          (grid.vertices(Eigen::all, grid.faces.col(f))).rowwise().mean();
+      const double nearest = (points.colwise() - centroid).colwise().norm().minCoeff();
+      EXPECT_LT(nearest, 1e-12) << "face " << f;
+    }
+  }
+}
+
+// Powers of two give the points of as many levels of linear subdivision.
+TEST(SurfaceSamplingTest, PowersOfTwoGiveTheLinearSubdivisionsPoints) {
+  const Mesh grid = GridMesh(4, 3, 0.01, /*curvature=*/0.0);
+  const Eigen::Matrix3Xd split = grid.vertices * SplitFaces(grid, 4).transpose();
+  const Mesh subdivided = ApplySubdivision(BuildLinearSubdivision(grid, 2), grid.vertices);
+  ASSERT_EQ(split.cols(), subdivided.num_vertices());
+  for (int v = 0; v < subdivided.num_vertices(); ++v) {
+    const double nearest =
+        (split.colwise() - subdivided.vertices.col(v)).colwise().norm().minCoeff();
+    EXPECT_LT(nearest, 1e-12) << "subdivided vertex " << v;
+  }
 }
 
 TEST(SurfaceSamplingTest, WiderPatchesTakeTheNeighboursFacesToo) {
   SampledScene scene = MakeSampledScene(0.0);
   const Eigen::Matrix3Xd normals = ComputeVertexNormals(scene.mesh);
   const SurfaceSamples wide =
-      SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods, /*patch_rings=*/2, 2);
+      SampleSurface(scene.mesh, normals, scene.surface, scene.neighbourhoods, /*patch_rings=*/2, 4);
   const int interior = 3 * 7 + 3;
   EXPECT_GT(wide.patches[interior].size(), 3 * scene.samples.patches[interior].size());
   std::vector<int> sorted = wide.patches[interior];
@@ -606,21 +649,21 @@ INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, SurfaceBlocksTest,
                          });
 
 // The covering set compares every sample between vertices that a patch holds through a patch,
-// each patch once: with samples inside the faces (two levels) one corner of each face, about a
-// third of the patches on a regular grid; with the faces split once, where the edges' midpoints
+// each patch once: with samples inside the faces (4 a side) one corner of each face, about a
+// third of the patches on a regular grid; with the faces split in two, where the edges' midpoints
 // are the only samples between vertices, one end of each edge, about two thirds.
 class FaceCoverTest : public testing::TestWithParam<int> {};
 
 TEST_P(FaceCoverTest, ComparesEverySampleBetweenVerticesInAFewPatches) {
-  const int levels = GetParam();
-  const SampledScene scene = MakeSampledScene(0.001, levels);
+  const int segments = GetParam();
+  const SampledScene scene = MakeSampledScene(0.001, segments);
   const ConsensusOptions options =
       SurfaceTermScene::Weighted(1.0, false, SurfacePatches::kFaceCover);
   const PixelConsensusSimilarity patches(scene.samples, scene.cameras, options);
   const SurfaceConsensusSimilarity surface(patches, scene.samples, options);
   const int num_patches = static_cast<int>(patches.residual_blocks().size());
   const int num_blocks = static_cast<int>(surface.residual_blocks().size());
-  const int between = levels == 1 ? 2 : 3;
+  const int between = segments == 2 ? 2 : 3;
   std::vector<char> in_a_patch(scene.samples.size(), 0), compared(in_a_patch.size(), 0);
   for (int b = 0; b < num_patches; ++b) {
     for (int j = 0; j < patches.PatchSize(b); ++j) in_a_patch[patches.Members(b)[j]] = 1;
@@ -640,7 +683,7 @@ TEST_P(FaceCoverTest, ComparesEverySampleBetweenVerticesInAFewPatches) {
   }
   EXPECT_GT(checked, 50);
   const double share = static_cast<double>(num_blocks) / num_patches;
-  if (levels == 1) {
+  if (segments == 2) {
     EXPECT_GT(share, 0.55);
     EXPECT_LT(share, 0.8);
   } else {
@@ -649,9 +692,9 @@ TEST_P(FaceCoverTest, ComparesEverySampleBetweenVerticesInAFewPatches) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, FaceCoverTest, testing::Values(1, 2),
+INSTANTIATE_TEST_SUITE_P(SurfaceConsensusTest, FaceCoverTest, testing::Values(2, 4),
                          [](const testing::TestParamInfo<int>& info) {
-                           return info.param == 1 ? "EdgesOnly" : "InsideTheFaces";
+                           return info.param == 2 ? "EdgesOnly" : "InsideTheFaces";
                          });
 
 TEST(SurfaceConsensusTest, GradientMatchesCentralDifferences) {

@@ -111,10 +111,10 @@ constexpr double kSecondsPerSampleRead = 0.116e-6;
 // 0.134 and 0.127 us a pixel pair.
 constexpr double kSecondsPerHeldOutPixelPair = 0.13e-6;
 
-// The samples of a regular vertex's patch of `rings` rings after `levels` of linear subdivision:
-// the hexagon of radius rings * 2^levels without its rim.
-int SamplesPerRegularPatch(int rings, int levels) {
-  const int radius = rings << levels;
+// The samples of a regular vertex's patch of `rings` rings, its faces split into `segments` a side:
+// the hexagon of radius rings * segments without its rim.
+int SamplesPerRegularPatch(int rings, int segments) {
+  const int radius = rings * segments;
   return 1 + 3 * (radius - 1) * radius;
 }
 
@@ -234,9 +234,11 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
   const bool sampled = NeedsOf(options.energy).reads_surface_samples;
   double detail_bytes = 0.0, detail_seconds = 0.0;
   if (sampled) {
-    const int levels = SampleLevels(fine, frame.cameras, options.energy.consensus.sample_spacing);
-    size.num_surface_samples = fine.num_vertices() * std::pow(4.0, levels);
-    size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), levels);
+    const int segments =
+        SampleSegments(fine, frame.cameras, options.energy.consensus.sample_spacing);
+    // segments^2 samples a vertex: V vertices, 3 V edges and 2 V faces on a closed mesh.
+    size.num_surface_samples = fine.num_vertices() * double(segments) * segments;
+    size.samples_per_patch = SamplesPerRegularPatch(PatchRingsAt(options), segments);
     detail_bytes = DetailStageBytes(size, options.energy.consensus.surface_weight > 0.0);
     detail_seconds = SampleReads(size) * kSecondsPerSampleRead;
   }

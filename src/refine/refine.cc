@@ -381,9 +381,9 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
       DetailVisibility(*frame, found_surface, found_normals, input, options);
   SurfaceGaussians surface = frame->energy->surface();
   frame->energy.reset();  // Its pair lists and tables are not needed any more.
-  const int levels = SampleLevels(frame->fine, input.cameras, consensus.sample_spacing);
+  const int segments = SampleSegments(frame->fine, input.cameras, consensus.sample_spacing);
   SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
-                                         model.neighbourhoods(), PatchRingsAt(options), levels);
+                                         model.neighbourhoods(), PatchRingsAt(options), segments);
   if (consensus.shared_appearance && input.frame_before_appearance.cols() == samples.size()) {
     samples.appearance = input.frame_before_appearance;
   }

@@ -1,12 +1,13 @@
 // The samples at which the consensus similarity reads the images at their own resolution
 // (ConsensusOptions::sample_spacing, SurfaceSamples in frame_energy.h): the refined mesh's
-// faces split linearly until their edges are about `sample_spacing` pixel footprints long.
+// faces split into equal triangles whose sides are about `sample_spacing` pixel footprints long.
 #ifndef FINECAP_SRC_REFINE_SURFACE_SAMPLING_H_
 #define FINECAP_SRC_REFINE_SURFACE_SAMPLING_H_
 
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "finecap/energy/frame_energy.h"
 #include "finecap/geometry/mesh.h"
@@ -16,20 +17,23 @@
 
 namespace finecap {
 
-// Levels of linear subdivision that bring the mean edge of `mesh` to at most `spacing` pixel
-// footprints (the median over the cameras, as MeasureSceneScale measures it), at most 4.
-int SampleLevels(const Mesh& mesh, const std::vector<Camera>& cameras, double spacing);
+// Segments a side that split the mean edge of `mesh` into pieces of at most `spacing` pixel
+// footprints (the median over the cameras, as MeasureSceneScale measures it), from 1 to 16. Any
+// count, not a power of two: the spacing a user asks for is what the samples get, within a
+// segment, and their number (the cost of the detail stage) grows with the square of the count.
+int SampleSegments(const Mesh& mesh, const std::vector<Camera>& cameras, double spacing);
 
-// The samples of `mesh` (with unit vertex normals `normals`) after `levels` of linear
-// subdivision, blended from the surface Gaussians of `surface` (its vertex_ids are vertices of
-// `mesh`; a sample of a face none of whose corners is a surface Gaussian keeps no weight). The
-// patch of a surface Gaussian holds the samples of the faces around it and, for `patch_rings`
-// above 1, around its neighbours up to patch_rings - 1 edges away (`neighbourhoods`, over the
-// vertices of `mesh`, must reach that far).
+// The points of `mesh`'s faces each split into segments^2 equal triangles, as a points x vertices
+// matrix of the barycentric weights of each point on its face's corners: the vertices first, each
+// with its own id; then the segments - 1 points inside each edge (MeshEdges' order), shared by the
+// edge's faces; then the points inside each face. With 2^L segments the points are those of L
+// levels of linear subdivision.
+Eigen::SparseMatrix<double> SplitFaces(const Mesh& mesh, int segments);
+
 SurfaceSamples SampleSurface(const Mesh& mesh, const Eigen::Matrix3Xd& normals,
                              const SurfaceGaussians& surface,
                              const VertexNeighbourhoods& neighbourhoods, int patch_rings,
-                             int levels);
+                             int segments);
 
 // Which samples a camera sees, from which surface Gaussians it sees (one flag each): a sample is
 // seen when every surface Gaussian it is blended from is. (A face whose corners a camera sees is

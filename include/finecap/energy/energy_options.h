@@ -53,9 +53,10 @@ struct ConsensusOptions {
   // The loss is on each patch's squared disagreement.
   double robust_fraction = 0.5;
   // 0: one colour per vertex, blurred by sigma_hat (ConsensusSimilarity). Above 0: a second
-  // solve, from the surface the surface Gaussians found, reads the samples (the faces split
-  // linearly until their edges are that short; PixelConsensusSimilarity): detail between the
-  // vertices, which the Gaussians blur away, steers each vertex.
+  // solve, from the surface the surface Gaussians found, reads the samples (each face split into
+  // equal triangles, as many a side as bring the mean edge to this length or less;
+  // PixelConsensusSimilarity): detail between the vertices, which the Gaussians blur away, steers
+  // each vertex.
   double sample_spacing = 1.0;
   // The samples read the blurred images by bilinear interpolation.
   double sample_blur = 0.4;
