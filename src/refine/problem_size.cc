@@ -73,17 +73,17 @@ constexpr double kSecondsPerSurfaceGaussian = 0.02e-3;
 //
 // Fitted 2026-12-06 (a grid minimising the worst log ratio, the process's 29 MB and the colour
 // tables, an exact count, held fixed) to the first frames of seven runs on 2 cores, each at the
-// search range it ended with: synth_demo (4 cameras of 512 px, 3 sample levels), synth_skirt (8
-// cameras of 1004 px), the Middlebury temple (16 cameras, and 12 with configs/temple.yaml, at
-// the 16.6 mm its sweep widened to), Sceaux (10 cameras of 708 x 532, and 8 with its
-// heldout.yaml) and Sceaux at full resolution (8 of 2832 x 2128, 4 sample levels; too many reads
-// to keep their table): every run's peak within 0.93-1.08 of its forecast, and the first stage's
-// own peak, measured apart, within 0.93-1.08 of its part. A two-frame synth_skirt run came to
-// 0.98 of its forecast. The constants' sizes are those of what they count: 4.5 bytes a pixel
-// for the 8-bit images and their decoding, 6.5 a pair (the pair lists' 8 bytes, most of them
-// held at once), 18.5 a pixel for the detail stage's images (3 floats, the blur's buffer, the
-// 8-bit images still held) and 270 a sample (position, normal, blend weights, visibility flags
-// per camera, the patches' member lists).
+// search range it ended with: synth_demo (4 cameras of 512 px, its faces split 8 a side then),
+// synth_skirt (8 cameras of 1004 px), the Middlebury temple (16 cameras, and 12 with
+// configs/temple.yaml, at the 16.6 mm its sweep widened to), Sceaux (10 cameras of 708 x 532, and
+// 8 with its heldout.yaml) and Sceaux at full resolution (8 of 2832 x 2128, 16 a side then; too
+// many reads to keep their table): every run's peak within 0.93-1.08 of its forecast, and the first
+// stage's own peak, measured apart, within 0.93-1.08 of its part. A two-frame synth_skirt run came
+// to 0.98 of its forecast. The constants' sizes are those of what they count: 4.5 bytes a pixel for
+// the 8-bit images and their decoding, 6.5 a pair (the pair lists' 8 bytes, most of them held at
+// once), 18.5 a pixel for the detail stage's images (3 floats, the blur's buffer, the 8-bit images
+// still held) and 270 a sample (position, normal, blend weights, visibility flags per camera, the
+// patches' member lists).
 constexpr double kBytesPerPixelWithSamples = 4.5;
 constexpr double kBytesPerConsensusPairWithSamples = 6.5;
 constexpr double kBytesPerSampledPixel = 18.5;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -28,11 +30,14 @@ Eigen::SparseMatrix<double> SplitFaces(const Mesh& mesh, int segments) {
   const MeshEdges edges = BuildMeshEdges(mesh.faces);
   const long num_edge_points = static_cast<long>(edges.num_edges()) * (n - 1);
   const long inside_per_face = static_cast<long>(n - 1) * (n - 2) / 2;
-  const long num_points = num_vertices + num_edge_points + mesh.num_faces() * inside_per_face;
+  const long num_inside_points = mesh.num_faces() * inside_per_face;
+  const long num_points = num_vertices + num_edge_points + num_inside_points;
+  Require(num_points <= std::numeric_limits<int>::max(), "SplitFaces",
+          "the mesh split " + std::to_string(n) + " a side has more points than a sample id holds");
   std::vector<Eigen::Triplet<double>> weights;
-  weights.reserve(num_vertices + 2 * num_edge_points + 3 * (num_points - num_vertices));
+  weights.reserve(num_vertices + 2 * num_edge_points + 3 * num_inside_points);
   for (int v = 0; v < num_vertices; ++v) weights.emplace_back(v, v, 1.0);
-  long point = num_vertices;
+  int point = num_vertices;
   for (int e = 0; e < edges.num_edges(); ++e) {
     for (int i = 1; i < n; ++i, ++point) {
       weights.emplace_back(point, edges.vertices(0, e), double(n - i) / n);
