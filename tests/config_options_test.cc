@@ -114,6 +114,7 @@ std::vector<std::pair<std::string, std::vector<OptionField>>> DeclaredFields() {
       {"SolverOptions::", SolverOptions::Fields().Declared()},
       {"SweepOptions::", SweepOptions::Fields().Declared()},
       {"CoarseToFineOptions::", CoarseToFineOptions::Fields().Declared()},
+      {"CameraAlignmentOptions::", CameraAlignmentOptions::Fields().Declared()},
       {"HeldOutOptions::", HeldOutOptions::Fields().Declared()},
       {"SynthOptions::", SynthOptions::Fields().Declared()},
       {"SynthOptions::smoothing.", TaubinSmoothingOptions::Fields().Declared()},

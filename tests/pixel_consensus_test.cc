@@ -16,6 +16,7 @@
 #include "finecap/geometry/mesh_edges.h"
 #include "finecap/geometry/subdivision.h"
 #include "finecap/util/error.h"
+#include "refine/camera_alignment.h"
 #include "refine/surface_sampling.h"
 
 namespace finecap {
@@ -199,6 +200,30 @@ TEST(SurfaceSamplingTest, ASampleIsSeenWhereEveryCornerItIsBlendedFromIs) {
   ASSERT_EQ(visible.size(), static_cast<size_t>(scene.samples.size()));
   for (int j = 0; j < scene.samples.size(); ++j) {
     EXPECT_EQ(visible[j] == 0, scene.samples.weights.coeff(j, hidden) > 0.0) << "sample " << j;
+  }
+}
+
+// A camera whose principal point is off by half a pixel is brought back in line with the others;
+// cameras already in line stay where they are.
+TEST(CameraAlignmentTest, ACameraOffByHalfAPixelIsBroughtBackInLine) {
+  const Eigen::Vector2d error(0.4, -0.3);
+  for (bool misaligned : {false, true}) {
+    SampledScene scene = MakeSampledScene(0.0);
+    // The images show the plane as the cameras really are; camera 1's calibration says otherwise.
+    if (misaligned) {
+      scene.cameras[1].camera.K(0, 2) += error.x();
+      scene.cameras[1].camera.K(1, 2) += error.y();
+    }
+    const std::vector<Eigen::Vector2d> shifts =
+        AlignCameras(scene.samples.base, /*max_rounds=*/30, &scene.cameras);
+    ASSERT_EQ(shifts.size(), 3u);
+    // Only the cameras' shifts relative to each other are what the images say.
+    const Eigen::Vector2d relative = shifts[1] - 0.5 * (shifts[0] + shifts[2]);
+    const Eigen::Vector2d expected = misaligned ? Eigen::Vector2d(-error) : Eigen::Vector2d::Zero();
+    EXPECT_LT((relative - expected).norm(), 0.05)
+        << (misaligned ? "misaligned" : "aligned") << ": " << relative.transpose();
+    EXPECT_LT((shifts[0] - shifts[2]).norm(), 0.05)
+        << shifts[0].transpose() << " against " << shifts[2].transpose();
   }
 }
 

@@ -197,6 +197,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& FieldSectio
         {"SolverOptions::", {"solver."}},
         {"SweepOptions::", {"refine.sweep."}},
         {"CoarseToFineOptions::", {"refine.coarse_to_fine."}},
+        {"CameraAlignmentOptions::", {"refine.camera_alignment."}},
         {"HeldOutOptions::", {"validation."}},
         {"SequenceOptions::", {"model.", "refine.", "validation."}},
         {"RunEvaluationOptions::", {"model.", "eval."}},

@@ -58,6 +58,7 @@ FrameStats MakeFrameStats(const std::string& frame, const RefineOptions& options
   stats.surface_gaussians = result.num_surface_gaussians;
   stats.confident_share = ConfidentShare(result);
   stats.k_max_mm = 1000.0 * result.k_max;
+  stats.camera_shift_px = result.camera_shift;
   stats.image_gaussians = result.num_image_gaussians;
   stats.pairs = result.num_pairs;
   stats.worse = result.worse;
@@ -92,6 +93,7 @@ std::string ToJson(const FrameStats& s) {
        << ", \"surface_gaussians\": " << s.surface_gaussians
        << ", \"confident_share\": " << JsonNumber(s.confident_share)
        << ", \"k_max_mm\": " << JsonNumber(s.k_max_mm)
+       << ", \"camera_shift_px\": " << JsonNumber(s.camera_shift_px)
        << ", \"image_gaussians\": " << s.image_gaussians << ", \"pairs\": " << s.pairs
        << ", \"worse\": " << (s.worse ? "true" : "false")
        << ", \"kept_input\": " << (s.kept_input ? "true" : "false")
@@ -146,6 +148,7 @@ struct StatsFields {
       {"cpu_seconds", &FrameStats::cpu_seconds},
       {"confident_share", &FrameStats::confident_share},
       {"k_max_mm", &FrameStats::k_max_mm},
+      {"camera_shift_px", &FrameStats::camera_shift_px},
       {"rms_coarse_mm", &FrameStats::rms_coarse_mm},
       {"rms_subdivided_mm", &FrameStats::rms_subdivided_mm},
       {"rms_refined_mm", &FrameStats::rms_refined_mm},

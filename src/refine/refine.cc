@@ -11,6 +11,7 @@
 #include "finecap/geometry/render.h"
 #include "finecap/solvers/sweep.h"
 #include "finecap/util/error.h"
+#include "refine/camera_alignment.h"
 #include "refine/foreground.h"
 #include "refine/surface_sampling.h"
 
@@ -405,6 +406,17 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     }
     cameras[c].pixels = pixels[c];
   }
+  if (options.camera_alignment.max_rounds > 0) {
+    Eigen::Matrix3Xd points = samples.base;
+    const Eigen::VectorXd displacement = samples.weights * found;
+    for (int j = 0; j < samples.size(); ++j)
+      points.col(j) += displacement[j] * samples.normals.col(j);
+    frame->camera_shift = 0.0;
+    for (const Eigen::Vector2d& shift :
+         AlignCameras(points, options.camera_alignment.max_rounds, &cameras)) {
+      frame->camera_shift = std::max(frame->camera_shift, shift.norm());
+    }
+  }
   EnergyOptions energy = EnergyOptionsAt(options);
   energy.k_max = frame->k_max;  // The range the surface Gaussians' stage was solved in.
   frame->energy = std::make_unique<FrameEnergy>(std::move(surface), cameras, model.neighbourhoods(),
@@ -557,6 +569,7 @@ FrameResult RefineFrameStartingAt(const SequenceModel& model, const ReferenceCol
     const double seconds = frame.seconds;
     PrepareDetailEnergy(model, input, options, k, &frame);
     result.seconds_preparation += frame.seconds - seconds;
+    result.camera_shift = frame.camera_shift;
     // The solve of the Gaussians' stage was this energy's first pass.
     frame.energy->EndOfPass(k);
     TakeTheFrameBefore(input, frame.energy.get());

@@ -82,6 +82,8 @@ const OptionFields<RefineOptions>& RefineOptions::RunFields() {
               "Start each frame from the previous frame's displacement.");
     f.AddSection("coarse_to_fine", &RefineOptions::coarse_to_fine, CoarseToFineOptions::Fields());
     f.AddSection("sweep", &RefineOptions::sweep, SweepOptions::Fields());
+    f.AddSection("camera_alignment", &RefineOptions::camera_alignment,
+                 CameraAlignmentOptions::Fields());
     return f;
   }();
   return fields;
@@ -96,6 +98,7 @@ void RefineOptions::Check() const {
   solver.Check();
   sweep.Check();
   coarse_to_fine.Check();
+  camera_alignment.Check();
 }
 
 const OptionFields<CoarseToFineOptions>& CoarseToFineOptions::Fields() {
@@ -115,5 +118,22 @@ const OptionFields<CoarseToFineOptions>& CoarseToFineOptions::Fields() {
 }
 
 void CoarseToFineOptions::Check() const { Fields().CheckValues(*this, "CoarseToFineOptions::"); }
+
+const OptionFields<CameraAlignmentOptions>& CameraAlignmentOptions::Fields() {
+  static const OptionFields<CameraAlignmentOptions> fields = [] {
+    OptionFields<CameraAlignmentOptions> f;
+    f.AddInt("max_rounds", &CameraAlignmentOptions::max_rounds,
+             "Detail stage: rounds at most of aligning each camera with the others (a shift of its "
+             "principal point, per frame, that absorbs a calibration's error of a pixel or so); "
+             "ends when no camera moves by 0.01 px any more. 0: the cameras as given.",
+             0, 100);
+    return f;
+  }();
+  return fields;
+}
+
+void CameraAlignmentOptions::Check() const {
+  Fields().CheckValues(*this, "CameraAlignmentOptions::");
+}
 
 }  // namespace finecap

@@ -44,6 +44,10 @@ struct FrameStats {
   // The range of the displacements the frame was solved in (energy.k_max, or wider where its
   // plane sweep found that limiting), millimetres.
   double k_max_mm = std::numeric_limits<double>::quiet_NaN();
+  // The largest shift of a camera's principal point that the detail stage's alignment made
+  // (refine.camera_alignment), pixels: how far the calibration as given is from what the images
+  // say, at most. NaN without the alignment.
+  double camera_shift_px = std::numeric_limits<double>::quiet_NaN();
   long image_gaussians = 0;
   long pairs = 0;
   bool worse = false;       // The run's own energy, or the held-out NCC, says the frame got worse.

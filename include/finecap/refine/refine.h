@@ -8,6 +8,7 @@
 #ifndef FINECAP_REFINE_REFINE_H_
 #define FINECAP_REFINE_REFINE_H_
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -59,6 +60,16 @@ struct CoarseToFineOptions {
   void Check() const;
 };
 
+// The cameras aligned with each other before the detail stage reads them: per frame and camera,
+// a shift of the principal point (camera_alignment.h in src/refine says why and how). The fields
+// are documented where Fields() declares them (docs/configuration.md: refine.camera_alignment).
+struct CameraAlignmentOptions {
+  int max_rounds = 10;  // 0: the cameras as given.
+
+  static const OptionFields<CameraAlignmentOptions>& Fields();  // option_fields.h
+  void Check() const;
+};
+
 // Which lengths of RefineOptions follow from the scene's scale (scene_scale.h) instead of the
 // values their fields hold. Until ResolveSceneScaleDefaults replaces it, a marked field holds the
 // person-sized value finecap used before it measured the scene, and that is what RefineFrame
@@ -94,6 +105,7 @@ struct RefineOptions {
   // A plane-sweep search for each Gaussian's starting displacement (sweep.h).
   SweepOptions sweep;
   CoarseToFineOptions coarse_to_fine;
+  CameraAlignmentOptions camera_alignment;
 
   // The image model. Defaults differ from ImageGaussianOptions' (the paper's) in two measured
   // ways: leaves down to 2 px (sigma 1 px) keep the texture detail the similarity needs, and
@@ -260,6 +272,9 @@ struct PreparedFrame {
   double k_max = 0.0;
   long num_image_gaussians = 0;
   double seconds = 0.0;  // The preparation's, the sweep's included.
+  // The largest shift of a camera's principal point that the detail stage's alignment made
+  // (CameraAlignmentOptions), pixels; NaN before the detail stage or without the alignment.
+  double camera_shift = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Subdivision, visibility, image Gaussians, surface Gaussians and pair lists of one frame.
@@ -314,6 +329,7 @@ struct FrameResult {
   double seconds_preparation = 0.0;  // Subdivision, visibility, image Gaussians, pair lists.
   bool prepared_ahead = false;       // The configured level was prepared ahead (`ahead`).
   double seconds_total = 0.0;        // The whole frame.
+  double camera_shift = std::numeric_limits<double>::quiet_NaN();  // PreparedFrame's.
 };
 
 // The rings of the refined mesh a consensus patch reaches: energy.consensus.patch_rings counts

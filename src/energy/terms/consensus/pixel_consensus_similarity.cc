@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "finecap/geometry/bilinear.h"
 #include "finecap/geometry/spatial_order.h"
 #include "finecap/util/error.h"
 
@@ -13,59 +14,6 @@ namespace {
 
 // A patch needs its own sample and at least this many more to have a shape worth comparing.
 constexpr int kMinPatchSamples = 4;
-
-// Where a bilinear read of a CV_32FC3 image at (x, y) reads (pixel centres at integers): the
-// first of the four pixels around it, its offsets u, v from that pixel, and the direction
-// (dx, dy) along which the read's derivative is taken (that of the interpolant, so that it is
-// exact for the function the solvers see). Outside the image the position is clamped to its
-// border, where the derivative across the border is zero.
-struct BilinearCell {
-  const float* top;  // The row below it is `row_step` floats on.
-  double u, v, dx, dy;
-};
-
-inline BilinearCell CellAt(const cv::Mat& image, double x, double y, double dx, double dy) {
-  const double max_x = image.cols - 1.0, max_y = image.rows - 1.0;
-  if (!(x > 0.0 && x < max_x)) {
-    x = std::clamp(x, 0.0, max_x);
-    dx = 0.0;
-  }
-  if (!(y > 0.0 && y < max_y)) {
-    y = std::clamp(y, 0.0, max_y);
-    dy = 0.0;
-  }
-  const int x0 = std::min(static_cast<int>(x), image.cols - 2);
-  const int y0 = std::min(static_cast<int>(y), image.rows - 2);
-  return {image.ptr<float>(y0) + 3 * x0, x - x0, y - y0, dx, dy};
-}
-
-// Writes the bilinear interpolant at `cell` (three channels) to `color` and, when `derivative` is
-// not null, its derivative along the cell's direction to it; `row_step` floats from one image row
-// to the next.
-inline void ReadCell(const BilinearCell& cell, long row_step, double* color, double* derivative) {
-  const float* top = cell.top;
-  const float* bottom = top + row_step;
-  for (int channel = 0; channel < 3; ++channel) {
-    const double c00 = top[channel], c10 = top[channel + 3];
-    const double c01 = bottom[channel], c11 = bottom[channel + 3];
-    const double along_top = c10 - c00, along_bottom = c11 - c01;
-    const double upper = c00 + cell.u * along_top, lower = c01 + cell.u * along_bottom;
-    color[channel] = upper + cell.v * (lower - upper);
-    if (derivative != nullptr) {
-      derivative[channel] =
-          cell.dx * (along_top + cell.v * (along_bottom - along_top)) + cell.dy * (lower - upper);
-    }
-  }
-}
-
-// Floats from one row of a CV_32FC3 image to the next.
-inline long RowStep(const cv::Mat& image) { return static_cast<long>(image.step1()); }
-
-// The bilinear interpolant of a CV_32FC3 image at (x, y), as CellAt and ReadCell.
-inline void ReadBilinear(const cv::Mat& image, double x, double y, double dx, double dy,
-                         double* color, double* derivative) {
-  ReadCell(CellAt(image, x, y, dx, dy), RowStep(image), color, derivative);
-}
 
 // The pixel of the homogeneous pixel `at_zero` + k `direction` (a sample's projection moved by k
 // along its normal: a straight line), and its k-derivative.

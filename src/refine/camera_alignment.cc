@@ -1,0 +1,114 @@
+#include "refine/camera_alignment.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include "finecap/geometry/bilinear.h"
+
+namespace finecap {
+namespace {
+
+// Samples that a camera must share with the others for its step to count.
+constexpr int kMinSharedSamples = 50;
+
+// Whether camera `camera` reads sample j: it sees it and, with a mask, on its foreground.
+bool Reads(const CameraInput& camera, int j) {
+  return camera.samples_visible[j] != 0 &&
+         (camera.samples_on_foreground.empty() || camera.samples_on_foreground[j] != 0);
+}
+
+// Whether a read at `pixel` stays inside the image with its four pixels.
+bool Inside(const cv::Mat& image, const Eigen::Vector2d& pixel) {
+  return pixel.x() >= 0.0 && pixel.y() >= 0.0 && pixel.x() < image.cols - 1.0 &&
+         pixel.y() < image.rows - 1.0;
+}
+
+// Each camera's colours at `points` (3 x samples, NaN where it does not read the sample).
+std::vector<Eigen::Matrix3Xd> ReadColors(const Eigen::Matrix3Xd& points,
+                                         const std::vector<CameraInput>& cameras) {
+  std::vector<Eigen::Matrix3Xd> colors(cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const CameraInput& camera = cameras[c];
+    colors[c].setConstant(3, points.cols(), std::nan(""));
+#pragma omp parallel for schedule(static)
+    for (Eigen::Index j = 0; j < points.cols(); ++j) {
+      if (!Reads(camera, static_cast<int>(j))) continue;
+      const Eigen::Vector2d pixel = camera.camera.Project(points.col(j));
+      if (!Inside(camera.pixels, pixel)) continue;
+      ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 0.0, colors[c].col(j).data(), nullptr);
+    }
+  }
+  return colors;
+}
+
+// Camera c's least-squares step (pixels) towards the mean of the other cameras' `colors`, or
+// zero when it shares too few samples with them or their gradients leave the step undetermined.
+Eigen::Vector2d StepOf(int c, const Eigen::Matrix3Xd& points,
+                       const std::vector<CameraInput>& cameras,
+                       const std::vector<Eigen::Matrix3Xd>& colors) {
+  const CameraInput& camera = cameras[c];
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d right = Eigen::Vector2d::Zero();
+  int shared = 0;
+  for (Eigen::Index j = 0; j < points.cols(); ++j) {
+    if (!std::isfinite(colors[c](0, j))) continue;
+    Eigen::Vector3d others = Eigen::Vector3d::Zero();
+    int num_others = 0;
+    for (size_t a = 0; a < cameras.size(); ++a) {
+      if (static_cast<int>(a) == c || !std::isfinite(colors[a](0, j))) continue;
+      others += colors[a].col(j);
+      ++num_others;
+    }
+    if (num_others == 0) continue;
+    ++shared;
+    const Eigen::Vector2d pixel = camera.camera.Project(points.col(j));
+    double color[3], along_x[3], along_y[3];
+    ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 1.0, 0.0, color, along_x);
+    ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 1.0, color, along_y);
+    const Eigen::Vector3d difference = colors[c].col(j) - others / num_others;
+    for (int channel = 0; channel < 3; ++channel) {
+      const Eigen::Vector2d gradient(along_x[channel], along_y[channel]);
+      normal += gradient * gradient.transpose();
+      right -= gradient * difference[channel];
+    }
+  }
+  // A direction without gradient (a plain or striped region alone) leaves the step undetermined.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(normal);
+  if (shared < kMinSharedSamples || !(eigen.eigenvalues()[0] > 1e-9 * eigen.eigenvalues()[1])) {
+    return Eigen::Vector2d::Zero();
+  }
+  return normal.ldlt().solve(right);
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int max_rounds,
+                                          std::vector<CameraInput>* cameras) {
+  const int num_cameras = static_cast<int>(cameras->size());
+  std::vector<Eigen::Vector2d> shifts(num_cameras, Eigen::Vector2d::Zero());
+  for (int round = 0; round < max_rounds; ++round) {
+    const std::vector<Eigen::Matrix3Xd> colors = ReadColors(points, *cameras);
+    std::vector<Eigen::Vector2d> steps(num_cameras);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int c = 0; c < num_cameras; ++c) {
+      // Half the step: the others, which camera c was compared with, move too.
+      steps[c] = 0.5 * StepOf(c, points, *cameras, colors);
+      const double length = steps[c].norm();
+      if (length > kMaxAlignmentStepPixels) steps[c] *= kMaxAlignmentStepPixels / length;
+    }
+    double largest = 0.0;
+    for (int c = 0; c < num_cameras; ++c) {
+      largest = std::max(largest, steps[c].norm());
+      (*cameras)[c].camera.K(0, 2) += steps[c].x();
+      (*cameras)[c].camera.K(1, 2) += steps[c].y();
+      shifts[c] += steps[c];
+    }
+    if (largest < kAlignmentTolerancePixels) break;
+  }
+  return shifts;
+}
+
+}  // namespace finecap
