@@ -26,19 +26,34 @@ bool Inside(const cv::Mat& image, const Eigen::Vector2d& pixel) {
          pixel.y() < image.rows - 1.0;
 }
 
-// Each camera's colours at `points` (3 x samples, NaN where it does not read the sample).
-std::vector<Eigen::Matrix3Xd> ReadColors(const Eigen::Matrix3Xd& points,
+// At most kMaxAlignmentSamples of `num_samples` samples, every stride-th: spread over the
+// surface as its numbering is (the vertices, then each edge's points, then each face's).
+std::vector<int> SpreadSamples(int num_samples) {
+  const int stride = std::max(1, (num_samples + kMaxAlignmentSamples - 1) / kMaxAlignmentSamples);
+  std::vector<int> chosen;
+  for (int j = 0; j < num_samples; j += stride) chosen.push_back(j);
+  return chosen;
+}
+
+// Each camera's colours at the samples `chosen` of `points` (3 x chosen, NaN where it does not
+// read the sample).
+std::vector<Eigen::Matrix3Xf> ReadColors(const Eigen::Matrix3Xd& points,
+                                         const std::vector<int>& chosen,
                                          const std::vector<CameraInput>& cameras) {
-  std::vector<Eigen::Matrix3Xd> colors(cameras.size());
+  const int n = static_cast<int>(chosen.size());
+  std::vector<Eigen::Matrix3Xf> colors(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     const CameraInput& camera = cameras[c];
-    colors[c].setConstant(3, points.cols(), std::nan(""));
+    colors[c].setConstant(3, n, std::nanf(""));
 #pragma omp parallel for schedule(static)
-    for (Eigen::Index j = 0; j < points.cols(); ++j) {
-      if (!Reads(camera, static_cast<int>(j))) continue;
+    for (int i = 0; i < n; ++i) {
+      const int j = chosen[i];
+      if (!Reads(camera, j)) continue;
       const Eigen::Vector2d pixel = camera.camera.Project(points.col(j));
       if (!Inside(camera.pixels, pixel)) continue;
-      ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 0.0, colors[c].col(j).data(), nullptr);
+      double color[3];
+      ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 0.0, color, nullptr);
+      colors[c].col(i) = Eigen::Vector3d(color[0], color[1], color[2]).cast<float>();
     }
   }
   return colors;
@@ -46,29 +61,29 @@ std::vector<Eigen::Matrix3Xd> ReadColors(const Eigen::Matrix3Xd& points,
 
 // Camera c's least-squares step (pixels) towards the mean of the other cameras' `colors`, or
 // zero when it shares too few samples with them or their gradients leave the step undetermined.
-Eigen::Vector2d StepOf(int c, const Eigen::Matrix3Xd& points,
+Eigen::Vector2d StepOf(int c, const Eigen::Matrix3Xd& points, const std::vector<int>& chosen,
                        const std::vector<CameraInput>& cameras,
-                       const std::vector<Eigen::Matrix3Xd>& colors) {
+                       const std::vector<Eigen::Matrix3Xf>& colors) {
   const CameraInput& camera = cameras[c];
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d right = Eigen::Vector2d::Zero();
   int shared = 0;
-  for (Eigen::Index j = 0; j < points.cols(); ++j) {
-    if (!std::isfinite(colors[c](0, j))) continue;
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    if (!std::isfinite(colors[c](0, i))) continue;
     Eigen::Vector3d others = Eigen::Vector3d::Zero();
     int num_others = 0;
     for (size_t a = 0; a < cameras.size(); ++a) {
-      if (static_cast<int>(a) == c || !std::isfinite(colors[a](0, j))) continue;
-      others += colors[a].col(j);
+      if (static_cast<int>(a) == c || !std::isfinite(colors[a](0, i))) continue;
+      others += colors[a].col(i).cast<double>();
       ++num_others;
     }
     if (num_others == 0) continue;
     ++shared;
-    const Eigen::Vector2d pixel = camera.camera.Project(points.col(j));
+    const Eigen::Vector2d pixel = camera.camera.Project(points.col(chosen[i]));
     double color[3], along_x[3], along_y[3];
     ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 1.0, 0.0, color, along_x);
     ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 1.0, color, along_y);
-    const Eigen::Vector3d difference = colors[c].col(j) - others / num_others;
+    const Eigen::Vector3d difference = colors[c].col(i).cast<double>() - others / num_others;
     for (int channel = 0; channel < 3; ++channel) {
       const Eigen::Vector2d gradient(along_x[channel], along_y[channel]);
       normal += gradient * gradient.transpose();
@@ -89,13 +104,14 @@ std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int ma
                                           std::vector<CameraInput>* cameras) {
   const int num_cameras = static_cast<int>(cameras->size());
   std::vector<Eigen::Vector2d> shifts(num_cameras, Eigen::Vector2d::Zero());
+  const std::vector<int> chosen = SpreadSamples(static_cast<int>(points.cols()));
   for (int round = 0; round < max_rounds; ++round) {
-    const std::vector<Eigen::Matrix3Xd> colors = ReadColors(points, *cameras);
+    const std::vector<Eigen::Matrix3Xf> colors = ReadColors(points, chosen, *cameras);
     std::vector<Eigen::Vector2d> steps(num_cameras);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int c = 0; c < num_cameras; ++c) {
       // Half the step: the others, which camera c was compared with, move too.
-      steps[c] = 0.5 * StepOf(c, points, *cameras, colors);
+      steps[c] = 0.5 * StepOf(c, points, chosen, *cameras, colors);
       const double length = steps[c].norm();
       if (length > kMaxAlignmentStepPixels) steps[c] *= kMaxAlignmentStepPixels / length;
     }

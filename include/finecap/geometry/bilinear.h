@@ -1,6 +1,6 @@
 // Bilinear reads of a three-channel float image (CV_32FC3) and of their derivative along a
 // direction of the image: what the detail stage reads the images with at the surface's samples,
-// and what the cameras' alignment reads them with (refine/camera_alignment.h).
+// and what the alignment of the cameras before that stage reads them with.
 #ifndef FINECAP_GEOMETRY_BILINEAR_H_
 #define FINECAP_GEOMETRY_BILINEAR_H_
 
