@@ -367,6 +367,22 @@ std::vector<double> ViewCosines(const Camera& camera, const Eigen::Matrix3Xd& ve
   return cosines;
 }
 
+// Aligns `cameras` with each other (AlignCameras) at the samples moved to the surface `found`
+// (one k per surface Gaussian); the largest shift of a camera, pixels.
+double AlignAtFoundSurface(const SurfaceSamples& samples, const Eigen::VectorXd& found,
+                           int max_rounds, std::vector<CameraInput>* cameras) {
+  Eigen::Matrix3Xd points = samples.base;
+  const Eigen::VectorXd displacement = samples.weights * found;
+  for (int j = 0; j < samples.size(); ++j) {
+    points.col(j) += displacement[j] * samples.normals.col(j);
+  }
+  double largest = 0.0;
+  for (const Eigen::Vector2d& shift : AlignCameras(points, max_rounds, cameras)) {
+    largest = std::max(largest, shift.norm());
+  }
+  return largest;
+}
+
 }  // namespace
 
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
@@ -407,15 +423,8 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
     cameras[c].pixels = pixels[c];
   }
   if (options.camera_alignment.max_rounds > 0) {
-    Eigen::Matrix3Xd points = samples.base;
-    const Eigen::VectorXd displacement = samples.weights * found;
-    for (int j = 0; j < samples.size(); ++j)
-      points.col(j) += displacement[j] * samples.normals.col(j);
-    frame->camera_shift = 0.0;
-    for (const Eigen::Vector2d& shift :
-         AlignCameras(points, options.camera_alignment.max_rounds, &cameras)) {
-      frame->camera_shift = std::max(frame->camera_shift, shift.norm());
-    }
+    frame->camera_shift =
+        AlignAtFoundSurface(samples, found, options.camera_alignment.max_rounds, &cameras);
   }
   EnergyOptions energy = EnergyOptionsAt(options);
   energy.k_max = frame->k_max;  // The range the surface Gaussians' stage was solved in.

@@ -285,9 +285,10 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 // one that reads the input's images at their own resolution over the same surface Gaussians
 // (ConsensusOptions::sample_spacing): the detail stage RefineFrame solves last. Its cameras are
 // those that see the surface found, smoothed as its patches' shape will be, within
-// VisibilityOptions::sample_view_angle_deg. Its patches start unshaped, until it is handed the
-// surface solved before (FrameEnergy::EndOfPass). Throws Error unless `found` has one entry per
-// surface Gaussian.
+// VisibilityOptions::sample_view_angle_deg, and it reads them aligned with each other at that
+// surface (CameraAlignmentOptions; the shift in PreparedFrame::camera_shift). Its patches start
+// unshaped, until it is handed the surface solved before (FrameEnergy::EndOfPass). Throws Error
+// unless `found` has one entry per surface Gaussian.
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
                          const RefineOptions& options, const Eigen::VectorXd& found,
                          PreparedFrame* frame);
