@@ -35,13 +35,21 @@ std::vector<int> SpreadSamples(int num_samples) {
   return chosen;
 }
 
-// Each camera's colours at the samples `chosen` of `points` (3 x chosen, NaN where it does not
-// read the sample).
-std::vector<Eigen::Matrix3Xf> ReadColors(const Eigen::Matrix3Xd& points,
-                                         const std::vector<int>& chosen,
-                                         const std::vector<CameraInput>& cameras) {
+// One round's reads of the samples `chosen`: each camera's colours (3 x chosen, NaN where it does
+// not read the sample), and per sample their sum over the cameras and how many read it, from
+// which each camera's "others' mean" follows without summing the others again.
+struct RoundReads {
+  std::vector<Eigen::Matrix3Xf> colors;
+  Eigen::Matrix3Xd sums;
+  std::vector<int> counts;
+};
+
+RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& chosen,
+                      const std::vector<CameraInput>& cameras) {
   const int n = static_cast<int>(chosen.size());
-  std::vector<Eigen::Matrix3Xf> colors(cameras.size());
+  RoundReads reads;
+  std::vector<Eigen::Matrix3Xf>& colors = reads.colors;
+  colors.resize(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     const CameraInput& camera = cameras[c];
     colors[c].setConstant(3, n, std::nanf(""));
@@ -56,34 +64,37 @@ std::vector<Eigen::Matrix3Xf> ReadColors(const Eigen::Matrix3Xd& points,
       colors[c].col(i) = Eigen::Vector3d(color[0], color[1], color[2]).cast<float>();
     }
   }
-  return colors;
+  reads.sums.setZero(3, n);
+  reads.counts.assign(n, 0);
+  for (const Eigen::Matrix3Xf& camera_colors : colors) {
+    for (int i = 0; i < n; ++i) {
+      if (!std::isfinite(camera_colors(0, i))) continue;
+      reads.sums.col(i) += camera_colors.col(i).cast<double>();
+      ++reads.counts[i];
+    }
+  }
+  return reads;
 }
 
-// Camera c's least-squares step (pixels) towards the mean of the other cameras' `colors`, or
+// Camera c's least-squares step (pixels) towards the mean of the other cameras' colours, or
 // zero when it shares too few samples with them or their gradients leave the step undetermined.
 Eigen::Vector2d StepOf(int c, const Eigen::Matrix3Xd& points, const std::vector<int>& chosen,
-                       const std::vector<CameraInput>& cameras,
-                       const std::vector<Eigen::Matrix3Xf>& colors) {
+                       const std::vector<CameraInput>& cameras, const RoundReads& reads) {
   const CameraInput& camera = cameras[c];
+  const Eigen::Matrix3Xf& own = reads.colors[c];
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d right = Eigen::Vector2d::Zero();
   int shared = 0;
   for (size_t i = 0; i < chosen.size(); ++i) {
-    if (!std::isfinite(colors[c](0, i))) continue;
-    Eigen::Vector3d others = Eigen::Vector3d::Zero();
-    int num_others = 0;
-    for (size_t a = 0; a < cameras.size(); ++a) {
-      if (static_cast<int>(a) == c || !std::isfinite(colors[a](0, i))) continue;
-      others += colors[a].col(i).cast<double>();
-      ++num_others;
-    }
-    if (num_others == 0) continue;
+    const int num_others = reads.counts[i] - 1;
+    if (!std::isfinite(own(0, i)) || num_others == 0) continue;
     ++shared;
     const Eigen::Vector2d pixel = camera.camera.Project(points.col(chosen[i]));
     double color[3], along_x[3], along_y[3];
     ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 1.0, 0.0, color, along_x);
     ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 1.0, color, along_y);
-    const Eigen::Vector3d difference = colors[c].col(i).cast<double>() - others / num_others;
+    const Eigen::Vector3d colour = own.col(i).cast<double>();
+    const Eigen::Vector3d difference = colour - (reads.sums.col(i) - colour) / num_others;
     for (int channel = 0; channel < 3; ++channel) {
       const Eigen::Vector2d gradient(along_x[channel], along_y[channel]);
       normal += gradient * gradient.transpose();
@@ -106,12 +117,12 @@ std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int ma
   std::vector<Eigen::Vector2d> shifts(num_cameras, Eigen::Vector2d::Zero());
   const std::vector<int> chosen = SpreadSamples(static_cast<int>(points.cols()));
   for (int round = 0; round < max_rounds; ++round) {
-    const std::vector<Eigen::Matrix3Xf> colors = ReadColors(points, chosen, *cameras);
+    const RoundReads reads = ReadColors(points, chosen, *cameras);
     std::vector<Eigen::Vector2d> steps(num_cameras);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int c = 0; c < num_cameras; ++c) {
       // Half the step: the others, which camera c was compared with, move too.
-      steps[c] = 0.5 * StepOf(c, points, chosen, *cameras, colors);
+      steps[c] = 0.5 * StepOf(c, points, chosen, *cameras, reads);
       const double length = steps[c].norm();
       if (length > kMaxAlignmentStepPixels) steps[c] *= kMaxAlignmentStepPixels / length;
     }
