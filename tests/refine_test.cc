@@ -25,6 +25,23 @@ class RefineFrameTest : public ::testing::Test {
 
 std::string* RefineFrameTest::directory_ = nullptr;
 
+// The residuals of an energy's first data term (the detail stage's patches).
+long DataResiduals(const FrameEnergy& energy) {
+  long count = 0;
+  for (const auto& block : energy.data_term(0).residual_blocks()) count += block.num_residuals;
+  return count;
+}
+
+// A surface found `fraction` of the size of `mesh`'s bounding box out on every other surface
+// Gaussian and as far in on the rest: one that faces no camera as the surface does.
+Eigen::VectorXd CrumpledSurface(int num_parameters, const Mesh& mesh, double fraction) {
+  const double amplitude =
+      fraction * (mesh.vertices.rowwise().maxCoeff() - mesh.vertices.rowwise().minCoeff()).norm();
+  Eigen::VectorXd found = Eigen::VectorXd::Constant(num_parameters, amplitude);
+  for (Eigen::Index s = 1; s < found.size(); s += 2) found[s] = -amplitude;
+  return found;
+}
+
 // With a schedule, the figures of the frame still refer to the configured energy: it starts
 // where a single-level solve starts and ends at the energy of the k it returns. One consensus
 // pass and no detail stage: a further pass, and the detail stage, shape the patches like the
@@ -101,34 +118,54 @@ TEST_F(RefineFrameTest, TheDetailStageReadsTheCamerasWithinItsOwnAngle) {
   const FrameInput input = ReadFrameInput(&capture, 0);
   const SequenceModel model(input.coarse, {}, defaults, "test");
   const ReferenceColors colors = ComputeSequenceColors(model, input, defaults);
-  // The detail stage's residuals with the surface found `amplitude` out on every other surface
-  // Gaussian and `amplitude` in on the rest (0: the input surface).
-  const auto detail_residuals = [&](double angle, double amplitude = 0.0) {
+  // The detail stage's residuals with the surface found crumpled by `fraction` of the scene's
+  // size (CrumpledSurface; 0: the input surface).
+  const auto detail_residuals = [&](double angle, double fraction = 0.0) {
     RefineOptions options = defaults;
     options.visibility.sample_view_angle_deg = angle;
     PreparedFrame frame = PrepareFrame(model, colors, input, options);
-    Eigen::VectorXd found = Eigen::VectorXd::Constant(frame.energy->num_parameters(), amplitude);
-    for (Eigen::Index s = 1; s < found.size(); s += 2) found[s] = -amplitude;
+    const Eigen::VectorXd found =
+        CrumpledSurface(frame.energy->num_parameters(), input.coarse, fraction);
     PrepareDetailEnergy(model, input, options, found, &frame);
-    long residuals = 0;
-    for (const auto& block : frame.energy->data_term(0).residual_blocks()) {
-      residuals += block.num_residuals;
-    }
-    return residuals;
+    return DataResiduals(*frame.energy);
   };
   EXPECT_GT(detail_residuals(80.0), detail_residuals(defaults.visibility.max_view_angle_deg));
   // A found surface crumpled by noise faces no camera as the surface does; its patches are still
   // read in the views that see the input most frontally (as many as at 1 degree and no noise:
   // those views alone).
-  const double noise = 0.05 * (input.coarse.vertices.rowwise().maxCoeff() -
-                               input.coarse.vertices.rowwise().minCoeff())
-                                  .norm();
-  EXPECT_GE(detail_residuals(defaults.visibility.sample_view_angle_deg, noise),
+  EXPECT_GE(detail_residuals(defaults.visibility.sample_view_angle_deg, 0.05),
             detail_residuals(1.0));
 
   PreparedFrame frame = PrepareFrame(model, colors, input, defaults);
   const Eigen::VectorXd too_short = Eigen::VectorXd::Zero(frame.energy->num_parameters() - 1);
   EXPECT_THROW(PrepareDetailEnergy(model, input, defaults, too_short, &frame), Error);
+}
+
+// With refine.views_follow_surface each pass of the detail stage after the first is prepared at
+// the surface the pass before found, from that pass's own energy: the energy so prepared is the
+// one prepared at that surface from the surface Gaussians' stage, and differs from the pass
+// before's where the surface found turns patches towards other cameras.
+TEST_F(RefineFrameTest, TheDetailStagesNextPassIsPreparedAtTheSurfaceFound) {
+  Capture capture = Capture::Open(*directory_);
+  const RefineOptions options;
+  const FrameInput input = ReadFrameInput(&capture, 0);
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, input, options);
+  PreparedFrame passes = PrepareFrame(model, colors, input, options);
+  const int n = passes.energy->num_parameters();
+  const Eigen::VectorXd found = CrumpledSurface(n, input.coarse, 0.05);
+  PrepareDetailEnergy(model, input, options, Eigen::VectorXd::Zero(n), &passes);
+  const long first_pass = DataResiduals(*passes.energy);
+  PrepareDetailEnergy(model, input, options, found, &passes);
+
+  PreparedFrame at_once = PrepareFrame(model, colors, input, options);
+  PrepareDetailEnergy(model, input, options, found, &at_once);
+  ASSERT_EQ(passes.energy->num_parameters(), n);
+  EXPECT_EQ(DataResiduals(*passes.energy), DataResiduals(*at_once.energy));
+  EXPECT_NE(DataResiduals(*passes.energy), first_pass);
+  const Eigen::VectorXd k = 0.1 * found;
+  EXPECT_NEAR(passes.energy->Evaluate(k, nullptr), at_once.energy->Evaluate(k, nullptr),
+              1e-12 * std::abs(at_once.energy->Evaluate(k, nullptr)));
 }
 
 // With energy.consensus.surface_weight the detail stage compares the refined mesh itself beside

@@ -80,6 +80,9 @@ const OptionFields<RefineOptions>& RefineOptions::RunFields() {
               "(always flagged).");
     f.AddBool("warm_start", &RefineOptions::warm_start,
               "Start each frame from the previous frame's displacement.");
+    f.AddBool("views_follow_surface", &RefineOptions::views_follow_surface,
+              "Find the detail stage's visibility, view angles and camera alignment again before "
+              "each of its passes, at the surface the pass before found.");
     f.AddSection("coarse_to_fine", &RefineOptions::coarse_to_fine, CoarseToFineOptions::Fields());
     f.AddSection("sweep", &RefineOptions::sweep, SweepOptions::Fields());
     f.AddSection("camera_alignment", &RefineOptions::camera_alignment,

@@ -101,6 +101,9 @@ struct RefineOptions {
   // says the frame got worse. The stats record flags such frames either way.
   bool keep_input_if_worse = false;
   bool warm_start = false;  // From the previous frame's k instead of from zero.
+  // Each pass of the detail stage after the first has an energy of its own, prepared at the
+  // surface the pass before found (visibility, view angles, camera alignment).
+  bool views_follow_surface = true;
 
   // A plane-sweep search for each Gaussian's starting displacement (sweep.h).
   SweepOptions sweep;
@@ -287,7 +290,9 @@ PreparedFrame PrepareFrame(const SequenceModel& model, const ReferenceColors& co
 // those that see the surface found, smoothed as its patches' shape will be, within
 // VisibilityOptions::sample_view_angle_deg, and it reads them aligned with each other at that
 // surface (CameraAlignmentOptions; the shift in PreparedFrame::camera_shift). Its patches start
-// unshaped, until it is handed the surface solved before (FrameEnergy::EndOfPass). Throws Error
+// unshaped, until it is handed the surface solved before (FrameEnergy::EndOfPass). The frame's
+// energy may be a detail stage's already: the next pass's is then prepared at the surface the
+// pass found (RefineOptions::views_follow_surface), from the same surface Gaussians. Throws Error
 // unless `found` has one entry per surface Gaussian.
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
                          const RefineOptions& options, const Eigen::VectorXd& found,
