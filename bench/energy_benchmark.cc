@@ -1,9 +1,9 @@
 // One evaluation of the energy and its gradient on a synth_skirt frame (10k surface Gaussians,
 // 8 cameras of 1004 x 1004), for both similarities, on one thread and on all threads, and the
-// block summaries Ceres' evaluation callback prepares instead at the same point; and the
-// preparation of a frame (subdivision, visibility, image Gaussians, pair lists); one solve of it;
-// and reading a
-// frame's input (the coarse mesh and every camera's image, decoded and undistorted).
+// block summaries Ceres' evaluation callback prepares instead at the same point; the preparation
+// of a frame (subdivision, visibility, image Gaussians, pair lists) and of its detail stage; one
+// solve of it; and reading a frame's input (the coarse mesh and every camera's image, decoded and
+// undistorted).
 //
 //   build/energy_benchmark [--benchmark_repetitions=5]
 //
@@ -147,6 +147,21 @@ void BM_DetailBlockSummaries(benchmark::State& state) {
       static_cast<double>(frame.energy->data_term(0).residual_blocks().size());
 }
 BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
+// The detail stage's preparation (PrepareDetailEnergy) at the surface the plane sweep found, as
+// each of its passes is prepared (refine.views_follow_surface): visibility, samples, images, the
+// cameras' alignment (refine.camera_alignment.max_rounds: the argument; 0 without) and the
+// energy.
+void BM_PrepareDetailEnergy(benchmark::State& state) {
+  const SkirtFrame& skirt = Skirt();
+  RefineOptions options;
+  options.camera_alignment.max_rounds = static_cast<int>(state.range(0));
+  PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+  const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
+  for (auto _ : state) PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  state.counters["camera_shift_px"] = frame.camera_shift;
+}
+BENCHMARK(BM_PrepareDetailEnergy)->Arg(0)->Arg(10)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The detail stage's second term (energy.consensus.surface_weight: the refined mesh itself, each
 // sample moved with its face's corners): its reduced rows with their Jacobians where the stage

@@ -36,10 +36,12 @@ std::vector<int> SpreadSamples(int num_samples) {
 }
 
 // One round's reads of the samples `chosen`: each camera's colours (3 x chosen, NaN where it does
-// not read the sample), and per sample their sum over the cameras and how many read it, from
-// which each camera's "others' mean" follows without summing the others again.
+// not read the sample) and the pixels it read them at, and per sample their sum over the cameras
+// and how many read it, from which each camera's "others' mean" follows without summing the
+// others again.
 struct RoundReads {
   std::vector<Eigen::Matrix3Xf> colors;
+  std::vector<Eigen::Matrix2Xd> pixels;
   Eigen::Matrix3Xd sums;
   std::vector<int> counts;
 };
@@ -50,9 +52,11 @@ RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& ch
   RoundReads reads;
   std::vector<Eigen::Matrix3Xf>& colors = reads.colors;
   colors.resize(cameras.size());
+  reads.pixels.resize(cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     const CameraInput& camera = cameras[c];
     colors[c].setConstant(3, n, std::nanf(""));
+    reads.pixels[c].resize(2, n);
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < n; ++i) {
       const int j = chosen[i];
@@ -62,6 +66,7 @@ RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& ch
       double color[3];
       ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 0.0, color, nullptr);
       colors[c].col(i) = Eigen::Vector3d(color[0], color[1], color[2]).cast<float>();
+      reads.pixels[c].col(i) = pixel;
     }
   }
   reads.sums.setZero(3, n);
@@ -78,21 +83,20 @@ RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& ch
 
 // Camera c's least-squares step (pixels) towards the mean of the other cameras' colours, or
 // zero when it shares too few samples with them or their gradients leave the step undetermined.
-Eigen::Vector2d StepOf(int c, const Eigen::Matrix3Xd& points, const std::vector<int>& chosen,
-                       const std::vector<CameraInput>& cameras, const RoundReads& reads) {
-  const CameraInput& camera = cameras[c];
+Eigen::Vector2d StepOf(int c, const std::vector<CameraInput>& cameras, const RoundReads& reads) {
+  const cv::Mat& image = cameras[c].pixels;
   const Eigen::Matrix3Xf& own = reads.colors[c];
   Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
   Eigen::Vector2d right = Eigen::Vector2d::Zero();
   int shared = 0;
-  for (size_t i = 0; i < chosen.size(); ++i) {
+  for (Eigen::Index i = 0; i < own.cols(); ++i) {
     const int num_others = reads.counts[i] - 1;
     if (!std::isfinite(own(0, i)) || num_others == 0) continue;
     ++shared;
-    const Eigen::Vector2d pixel = camera.camera.Project(points.col(chosen[i]));
-    double color[3], along_x[3], along_y[3];
-    ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 1.0, 0.0, color, along_x);
-    ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 1.0, color, along_y);
+    const Eigen::Vector2d pixel = reads.pixels[c].col(i);
+    double along_x[3], along_y[3];
+    ReadCellGradient(CellAt(image, pixel.x(), pixel.y(), 1.0, 1.0), RowStep(image), along_x,
+                     along_y);
     const Eigen::Vector3d colour = own.col(i).cast<double>();
     const Eigen::Vector3d difference = colour - (reads.sums.col(i) - colour) / num_others;
     for (int channel = 0; channel < 3; ++channel) {
@@ -122,7 +126,7 @@ std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int ma
 #pragma omp parallel for schedule(dynamic, 1)
     for (int c = 0; c < num_cameras; ++c) {
       // Half the step: the others, which camera c was compared with, move too.
-      steps[c] = 0.5 * StepOf(c, points, chosen, *cameras, reads);
+      steps[c] = 0.5 * StepOf(c, *cameras, reads);
       const double length = steps[c].norm();
       if (length > kMaxAlignmentStepPixels) steps[c] *= kMaxAlignmentStepPixels / length;
     }

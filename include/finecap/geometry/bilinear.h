@@ -54,6 +54,22 @@ inline void ReadCell(const BilinearCell& cell, long row_step, double* color, dou
   }
 }
 
+// The derivatives of the bilinear interpolant at `cell` along the image's x and y (three channels
+// each), times the cell's dx and dy: CellAt with dx = dy = 1 gives the gradient, zero across the
+// image's border. The read of ReadCell along (1, 0) and (0, 1) at once.
+inline void ReadCellGradient(const BilinearCell& cell, long row_step, double* along_x,
+                             double* along_y) {
+  const float* top = cell.top;
+  const float* bottom = top + row_step;
+  for (int channel = 0; channel < 3; ++channel) {
+    const double c00 = top[channel], c10 = top[channel + 3];
+    const double c01 = bottom[channel], c11 = bottom[channel + 3];
+    const double along_top = c10 - c00, along_bottom = c11 - c01;
+    along_x[channel] = cell.dx * (along_top + cell.v * (along_bottom - along_top));
+    along_y[channel] = cell.dy * ((c01 - c00) + cell.u * (along_bottom - along_top));
+  }
+}
+
 // Floats from one row of a CV_32FC3 image to the next.
 inline long RowStep(const cv::Mat& image) { return static_cast<long>(image.step1()); }
 
