@@ -28,7 +28,7 @@ args=(--config configs/temple.yaml --capture "$capture" --out "$work/run")
 /usr/bin/time -f "%e %M" -o "$work/refine.time" build/finecap refine "${args[@]}" \
   --set "${SET:-}" >/dev/null
 start=$(date +%s.%N)
-build/finecap eval "${args[@]}" --set eval.flow=none >/dev/null
+build/finecap eval "${args[@]}" --set "eval.flow=none${SET:+,$SET}" >/dev/null
 end=$(date +%s.%N)
 
 python3 bench/heldout_figures.py "$work/run"
