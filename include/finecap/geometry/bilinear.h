@@ -35,21 +35,31 @@ inline BilinearCell CellAt(const cv::Mat& image, double x, double y, double dx, 
   return {image.ptr<float>(y0) + 3 * x0, x - x0, y - y0, dx, dy};
 }
 
+// Channel `channel` of the bilinear interpolant at `cell`: its value and its derivatives along the
+// image's x and y; `row_step` floats from one image row to the next.
+struct CellChannelRead {
+  double color, along_x, along_y;
+};
+inline CellChannelRead ReadCellChannel(const BilinearCell& cell, long row_step, int channel) {
+  const float* top = cell.top + channel;
+  const float* bottom = top + row_step;
+  const double c00 = top[0], c10 = top[3];
+  const double c01 = bottom[0], c11 = bottom[3];
+  const double along_top = c10 - c00, along_bottom = c11 - c01;
+  const double upper = c00 + cell.u * along_top, lower = c01 + cell.u * along_bottom;
+  return {upper + cell.v * (lower - upper), along_top + cell.v * (along_bottom - along_top),
+          lower - upper};
+}
+
 // Writes the bilinear interpolant at `cell` (three channels) to `color` and, when `derivative` is
 // not null, its derivative along the cell's direction to it; `row_step` floats from one image row
 // to the next.
 inline void ReadCell(const BilinearCell& cell, long row_step, double* color, double* derivative) {
-  const float* top = cell.top;
-  const float* bottom = top + row_step;
   for (int channel = 0; channel < 3; ++channel) {
-    const double c00 = top[channel], c10 = top[channel + 3];
-    const double c01 = bottom[channel], c11 = bottom[channel + 3];
-    const double along_top = c10 - c00, along_bottom = c11 - c01;
-    const double upper = c00 + cell.u * along_top, lower = c01 + cell.u * along_bottom;
-    color[channel] = upper + cell.v * (lower - upper);
+    const CellChannelRead read = ReadCellChannel(cell, row_step, channel);
+    color[channel] = read.color;
     if (derivative != nullptr) {
-      derivative[channel] =
-          cell.dx * (along_top + cell.v * (along_bottom - along_top)) + cell.dy * (lower - upper);
+      derivative[channel] = cell.dx * read.along_x + cell.dy * read.along_y;
     }
   }
 }
@@ -59,14 +69,10 @@ inline void ReadCell(const BilinearCell& cell, long row_step, double* color, dou
 // image's border. The read of ReadCell along (1, 0) and (0, 1) at once.
 inline void ReadCellGradient(const BilinearCell& cell, long row_step, double* along_x,
                              double* along_y) {
-  const float* top = cell.top;
-  const float* bottom = top + row_step;
   for (int channel = 0; channel < 3; ++channel) {
-    const double c00 = top[channel], c10 = top[channel + 3];
-    const double c01 = bottom[channel], c11 = bottom[channel + 3];
-    const double along_top = c10 - c00, along_bottom = c11 - c01;
-    along_x[channel] = cell.dx * (along_top + cell.v * (along_bottom - along_top));
-    along_y[channel] = cell.dy * ((c01 - c00) + cell.u * (along_bottom - along_top));
+    const CellChannelRead read = ReadCellChannel(cell, row_step, channel);
+    along_x[channel] = cell.dx * read.along_x;
+    along_y[channel] = cell.dy * read.along_y;
   }
 }
 
