@@ -1,6 +1,7 @@
 // Foreground masks end to end: synth writes the subject's silhouettes, a capture reads them with
 // the images, and what the images hold outside them changes neither the refined surface nor the
 // held-out score.
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -116,6 +117,31 @@ TEST_F(MaskedCaptureTest, PixelsOutsideTheMasksDoNotChangeTheRefinement) {
   EXPECT_FALSE(BitwiseEqual(
       Refined(WithoutMasks(RepaintedInput(reference)), WithoutMasks(RepaintedInput(input))),
       unmasked));
+}
+
+// The detail stage's next pass is prepared from the energy of the pass before
+// (refine.views_follow_surface), which hands on its samples as the masks cut them: the energy is
+// the one prepared at once, and not the one prepared without the masks.
+TEST_F(MaskedCaptureTest, TheDetailStagesNextPassKeepsWhatTheMasksCut) {
+  Capture capture = Capture::Open(*directory_);
+  const FrameInput input = ReadFrameInput(&capture, 1);
+  RefineOptions options;
+  options.visibility.max_view_angle_deg = 60.0;
+  const SequenceModel model(input.coarse, {}, options, "test");
+  const ReferenceColors colors = ComputeSequenceColors(model, input, options);
+  // The detail stage's energy at k after `preparations` preparations at the input surface.
+  const auto detail_energy = [&](const FrameInput& frame_input, int preparations) {
+    PreparedFrame frame = PrepareFrame(model, colors, frame_input, options);
+    const Eigen::VectorXd input_surface = Eigen::VectorXd::Zero(frame.energy->num_parameters());
+    for (int p = 0; p < preparations; ++p) {
+      PrepareDetailEnergy(model, frame_input, options, input_surface, &frame);
+    }
+    return frame.energy->Evaluate(Eigen::VectorXd::Constant(input_surface.size(), 1e-3), nullptr);
+  };
+  // The threads sum in any order: equal within a few ulps.
+  const double at_once = detail_energy(input, 1);
+  EXPECT_NEAR(detail_energy(input, 2), at_once, 1e-12 * std::abs(at_once));
+  EXPECT_GT(std::abs(detail_energy(WithoutMasks(input), 1) - at_once), 1e-3 * std::abs(at_once));
 }
 
 // The held-out score measures the subject alone: repainting the background of every view changes

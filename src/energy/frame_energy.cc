@@ -74,6 +74,19 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
   }
 }
 
+SampledInput FrameEnergy::TakeSampledInput(std::unique_ptr<FrameEnergy> energy) {
+  // The terms read the samples and the cameras: they go first.
+  energy->last_pass_terms_.clear();
+  energy->data_terms_.clear();
+  SampledInput input;
+  input.samples = std::move(energy->samples_);
+  for (CameraInput& camera : energy->sample_cameras_) {
+    input.pixels.push_back(camera.pixels);
+    input.samples_on_foreground.push_back(std::move(camera.samples_on_foreground));
+  }
+  return input;
+}
+
 double FrameEnergy::TypicalDataCurvature() {
   // Measured once, at the input surface, so that every pull in its units is a fixed quadratic:
   // the solvers see one energy throughout.
@@ -94,7 +107,7 @@ Eigen::VectorXd FrameEnergy::UnknownsAtVertices(const Eigen::VectorXd& per_verte
 }
 
 void FrameEnergy::StartLastPass() {
-  for (auto& term : last_pass_terms_) data_terms_.push_back(std::move(term));
+  for (const auto& make_term : last_pass_terms_) data_terms_.push_back(make_term());
   last_pass_terms_.clear();
 }
 

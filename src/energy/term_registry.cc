@@ -61,12 +61,14 @@ DataTerms SampledTerms(const DataTermContext& context) {
       std::make_unique<PixelConsensusSimilarity>(context.samples, context.sample_cameras, options);
   patches->SmoothShapesOver(&context.neighbours);
   // The surface term reads through the patches; both live as long as the energy.
-  const PixelConsensusSimilarity& read_through = *patches;
+  const PixelConsensusSimilarity* read_through = patches.get();
   DataTerms terms;
   terms.from_first_pass.push_back(std::move(patches));
   if (options.surface_weight > 0.0) {
-    terms.from_last_pass.push_back(
-        std::make_unique<SurfaceConsensusSimilarity>(read_through, context.samples, options));
+    const SurfaceSamples* samples = &context.samples;
+    terms.from_last_pass.push_back([read_through, samples, &options] {
+      return std::make_unique<SurfaceConsensusSimilarity>(*read_through, *samples, options);
+    });
   }
   return terms;
 }

@@ -5,6 +5,7 @@
 #ifndef FINECAP_ENERGY_TERM_REGISTRY_H_
 #define FINECAP_ENERGY_TERM_REGISTRY_H_
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -35,7 +36,10 @@ struct DataTerms {
   std::vector<std::unique_ptr<DataTerm>> from_first_pass;
   // Summed from the last pass on (FrameEnergy::StartLastPass): the refined mesh read itself
   // (ConsensusOptions::surface_weight), which only the pass whose result is handed back needs.
-  std::vector<std::unique_ptr<DataTerm>> from_last_pass;
+  // Made when that pass starts, so that an energy whose last pass never comes (the detail stage
+  // prepared anew for its next pass, RefineOptions::views_follow_surface) does not build them;
+  // a maker reads the context's members and the first pass's terms, which outlive it.
+  std::vector<std::function<std::unique_ptr<DataTerm>()>> from_last_pass;
 };
 DataTerms MakeDataTerms(const DataTermContext& context);
 

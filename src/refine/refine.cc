@@ -383,6 +383,29 @@ double AlignAtFoundSurface(const SurfaceSamples& samples, const Eigen::VectorXd&
   return largest;
 }
 
+// What the detail stage reads that does not depend on the surface found (SampledInput): taken
+// from the frame's energy when that is a detail stage's already, over the same surface Gaussians
+// `surface`, made otherwise. The frame's energy is gone after: its pair lists and tables are not
+// needed any more.
+SampledInput DetailStageInput(const SequenceModel& model, const FrameInput& input,
+                              const RefineOptions& options, const SurfaceGaussians& surface,
+                              PreparedFrame* frame) {
+  SampledInput sampled = FrameEnergy::TakeSampledInput(std::move(frame->energy));
+  if (sampled.samples.size() > 0) return sampled;
+  const ConsensusOptions& consensus = options.energy.consensus;
+  const int segments = SampleSegments(frame->fine, input.cameras, consensus.sample_spacing);
+  sampled.samples = SampleSurface(frame->fine, frame->normals, surface, model.neighbourhoods(),
+                                  PatchRingsAt(options), segments);
+  sampled.pixels = SampledImages(input, options.image.color_space, consensus.sample_blur);
+  sampled.samples_on_foreground.resize(input.cameras.size());
+  for (size_t c = 0; c < input.masks.size(); ++c) {
+    sampled.samples_on_foreground[c].assign(sampled.samples.size(), 1);
+    KeepForeground(input.cameras[c], input.masks[c], sampled.samples.base, SampleReach(consensus),
+                   &sampled.samples_on_foreground[c]);
+  }
+  return sampled;
+}
+
 }  // namespace
 
 void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
@@ -397,15 +420,11 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
   const std::vector<std::vector<unsigned char>> visible =
       DetailVisibility(*frame, found_surface, found_normals, input, options);
   SurfaceGaussians surface = frame->energy->surface();
-  frame->energy.reset();  // Its pair lists and tables are not needed any more.
-  const int segments = SampleSegments(frame->fine, input.cameras, consensus.sample_spacing);
-  SurfaceSamples samples = SampleSurface(frame->fine, frame->normals, surface,
-                                         model.neighbourhoods(), PatchRingsAt(options), segments);
+  SampledInput sampled = DetailStageInput(model, input, options, surface, frame);
+  SurfaceSamples& samples = sampled.samples;
   if (consensus.shared_appearance && input.frame_before_appearance.cols() == samples.size()) {
     samples.appearance = input.frame_before_appearance;
   }
-  const std::vector<cv::Mat> pixels =
-      SampledImages(input, options.image.color_space, consensus.sample_blur);
   std::vector<CameraInput> cameras(input.cameras.size());
   for (size_t c = 0; c < cameras.size(); ++c) {
     cameras[c].camera = input.cameras[c];
@@ -415,12 +434,8 @@ void PrepareDetailEnergy(const SequenceModel& model, const FrameInput& input,
       cameras[c].view_cosines =
           ViewCosines(input.cameras[c], found_surface.vertices, found_normals, surface.vertex_ids);
     }
-    if (!input.masks.empty()) {
-      cameras[c].samples_on_foreground.assign(samples.size(), 1);
-      KeepForeground(input.cameras[c], input.masks[c], samples.base, SampleReach(consensus),
-                     &cameras[c].samples_on_foreground);
-    }
-    cameras[c].pixels = pixels[c];
+    cameras[c].samples_on_foreground = std::move(sampled.samples_on_foreground[c]);
+    cameras[c].pixels = sampled.pixels[c];
   }
   if (options.camera_alignment.max_rounds > 0) {
     frame->camera_shift =

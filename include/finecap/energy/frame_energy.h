@@ -14,6 +14,7 @@
 #ifndef FINECAP_FRAME_ENERGY_H_
 #define FINECAP_FRAME_ENERGY_H_
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -73,6 +74,17 @@ struct SurfaceSamples {
   int size() const { return static_cast<int>(base.cols()); }
 };
 
+// What an energy with surface samples reads that is the same wherever its surface is: the
+// samples, and per camera its pixels and which samples lie on its foreground (CameraInput). An
+// energy over the same surface Gaussians prepared anew at another surface (the detail stage's
+// next pass) takes them from the one before (FrameEnergy::TakeSampledInput) instead of making
+// them again.
+struct SampledInput {
+  SurfaceSamples samples;
+  std::vector<cv::Mat> pixels;
+  std::vector<std::vector<unsigned char>> samples_on_foreground;
+};
+
 // The bytes the consensus similarity keeps to read its samples faster: the homogeneous pixel of
 // each sample read by a patch in a camera and its derivative along the sample's normal (48 bytes
 // a read), when they come to at most `max_table_bytes`, else none: each read then projects its
@@ -97,6 +109,10 @@ class FrameEnergy {
   FrameEnergy(const FrameEnergy&) = delete;
   FrameEnergy& operator=(const FrameEnergy&) = delete;
 
+  // With samples, hands `energy`'s SampledInput over and frees the rest of it; without, frees it
+  // and returns an empty one.
+  static SampledInput TakeSampledInput(std::unique_ptr<FrameEnergy> energy);
+
   int num_parameters() const { return surface_.size(); }
   // The unknowns: num_parameters() displacements within [-k_max, k_max].
   ParameterLayout layout() const { return {num_parameters(), options_.k_max}; }
@@ -120,9 +136,10 @@ class FrameEnergy {
   // the pair lists stay as they are.
   void AddDataTerm(std::unique_ptr<DataTerm> term);
   // Adds to the sum the terms that only the solver's last pass needs (today the refined mesh's
-  // own term of the detail stage, ConsensusOptions::surface_weight); nothing after the first
-  // call. The structure of the residual blocks changes, so a solver builds its problem anew. As
-  // with AddDataTerm, the pulls keep the units measured of the terms the energy started with.
+  // own term of the detail stage, ConsensusOptions::surface_weight), made now; nothing after
+  // the first call. The structure of the residual blocks changes, so a solver builds its problem
+  // anew. As with AddDataTerm, the pulls keep the units measured of the terms the energy started
+  // with.
   void StartLastPass();
   // Whether every data term is least-squares (DataTerm::IsLeastSquares): then E is minus the
   // least-squares cost, E_data's half sum of squares plus E_quad.
@@ -175,9 +192,8 @@ class FrameEnergy {
   std::vector<EnergyView> views_;
   Regularizer regularizer_;  // Before the data terms: a term may read it.
   std::vector<std::unique_ptr<DataTerm>> data_terms_;
-  // Built with the others, summed from StartLastPass on. Declared after data_terms_, so freed
-  // first: a term here may read one there.
-  std::vector<std::unique_ptr<DataTerm>> last_pass_terms_;
+  // Made and summed from StartLastPass on; a term made here may read one made before it.
+  std::vector<std::function<std::unique_ptr<DataTerm>()>> last_pass_terms_;
   Eigen::VectorXd confidence_;
   std::vector<std::unique_ptr<QuadraticTerm>> quadratic_terms_;
   Pulls pulls_;
