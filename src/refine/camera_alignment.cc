@@ -46,9 +46,30 @@ struct RoundReads {
   std::vector<int> counts;
 };
 
-RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& chosen,
-                      const std::vector<CameraInput>& cameras) {
+// Each camera's pixels of the samples `chosen` as its calibration gives them (NaN where it does
+// not read the sample). A shift of the principal point shifts every pixel by as much, so that the
+// rounds project the samples once.
+std::vector<Eigen::Matrix2Xd> ProjectChosen(const Eigen::Matrix3Xd& points,
+                                            const std::vector<int>& chosen,
+                                            const std::vector<CameraInput>& cameras) {
   const int n = static_cast<int>(chosen.size());
+  std::vector<Eigen::Matrix2Xd> pixels(cameras.size());
+  for (size_t c = 0; c < cameras.size(); ++c) {
+    const CameraInput& camera = cameras[c];
+    pixels[c].setConstant(2, n, std::nan(""));
+#pragma omp parallel for schedule(static)
+    for (int i = 0; i < n; ++i) {
+      if (Reads(camera, chosen[i])) pixels[c].col(i) = camera.camera.Project(points.col(chosen[i]));
+    }
+  }
+  return pixels;
+}
+
+// The reads of one round, each camera's `projected` pixels moved by its `shifts`.
+RoundReads ReadColors(const std::vector<Eigen::Matrix2Xd>& projected,
+                      const std::vector<Eigen::Vector2d>& shifts,
+                      const std::vector<CameraInput>& cameras) {
+  const int n = static_cast<int>(projected.front().cols());
   RoundReads reads;
   std::vector<Eigen::Matrix3Xf>& colors = reads.colors;
   colors.resize(cameras.size());
@@ -59,9 +80,8 @@ RoundReads ReadColors(const Eigen::Matrix3Xd& points, const std::vector<int>& ch
     reads.pixels[c].resize(2, n);
 #pragma omp parallel for schedule(static)
     for (int i = 0; i < n; ++i) {
-      const int j = chosen[i];
-      if (!Reads(camera, j)) continue;
-      const Eigen::Vector2d pixel = camera.camera.Project(points.col(j));
+      const Eigen::Vector2d pixel = projected[c].col(i) + shifts[c];
+      // NaN where the camera does not read the sample: not inside.
       if (!Inside(camera.pixels, pixel)) continue;
       double color[3];
       ReadBilinear(camera.pixels, pixel.x(), pixel.y(), 0.0, 0.0, color, nullptr);
@@ -120,8 +140,10 @@ std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int ma
   const int num_cameras = static_cast<int>(cameras->size());
   std::vector<Eigen::Vector2d> shifts(num_cameras, Eigen::Vector2d::Zero());
   const std::vector<int> chosen = SpreadSamples(static_cast<int>(points.cols()));
+  if (chosen.empty() || num_cameras == 0) return shifts;
+  const std::vector<Eigen::Matrix2Xd> projected = ProjectChosen(points, chosen, *cameras);
   for (int round = 0; round < max_rounds; ++round) {
-    const RoundReads reads = ReadColors(points, chosen, *cameras);
+    const RoundReads reads = ReadColors(projected, shifts, *cameras);
     std::vector<Eigen::Vector2d> steps(num_cameras);
 #pragma omp parallel for schedule(dynamic, 1)
     for (int c = 0; c < num_cameras; ++c) {

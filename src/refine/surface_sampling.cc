@@ -10,6 +10,7 @@
 #include "finecap/geometry/color.h"
 #include "finecap/geometry/mesh_edges.h"
 #include "finecap/util/error.h"
+#include "finecap/util/threads.h"
 #include "refine/foreground.h"
 #include "refine/scene_scale.h"
 
@@ -122,10 +123,10 @@ std::vector<unsigned char> SampleVisibility(const SurfaceSamples& samples,
 
 std::vector<cv::Mat> SampledImages(const FrameInput& input, ColorSpace space, double blur) {
   std::vector<cv::Mat> images = ForegroundImages(input);
-  for (size_t c = 0; c < images.size(); ++c) {
+  ParallelFor(static_cast<int>(images.size()), [&](int c) {
     images[c] = ConvertImage(images[c], space, input.cameras[c].name);
     if (blur > 0.0) cv::GaussianBlur(images[c], images[c], cv::Size(0, 0), blur);
-  }
+  });
   return images;
 }
 
