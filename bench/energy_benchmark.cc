@@ -148,20 +148,37 @@ void BM_DetailBlockSummaries(benchmark::State& state) {
 }
 BENCHMARK(BM_DetailBlockSummaries)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
-// The detail stage's preparation (PrepareDetailEnergy) at the surface the plane sweep found, as
-// each of its passes is prepared (refine.views_follow_surface): visibility, samples, images, the
-// cameras' alignment (refine.camera_alignment.max_rounds: the argument; 0 without) and the
-// energy.
+// The detail stage's preparation (PrepareDetailEnergy) at the surface the plane sweep found:
+// visibility, samples, images, the cameras' alignment (refine.camera_alignment.max_rounds: the
+// first argument; 0 without) and the energy. With a second argument of 0, as its first pass is
+// prepared, from the surface Gaussians' stage (prepared anew, untimed, before each); with 1, as
+// each next pass is (refine.views_follow_surface), from the pass before, whose samples and
+// images it takes over.
 void BM_PrepareDetailEnergy(benchmark::State& state) {
   const SkirtFrame& skirt = Skirt();
   RefineOptions options;
   options.camera_alignment.max_rounds = static_cast<int>(state.range(0));
+  const bool from_pass_before = state.range(1) != 0;
   PreparedFrame frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
   const Eigen::VectorXd k = SweepInitialization(frame.energy.get(), options.sweep);
-  for (auto _ : state) PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  if (from_pass_before) PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  for (auto _ : state) {
+    if (!from_pass_before) {
+      state.PauseTiming();
+      frame = PrepareFrame(*skirt.model, skirt.colors, skirt.input, options);
+      state.ResumeTiming();
+    }
+    PrepareDetailEnergy(*skirt.model, skirt.input, options, k, &frame);
+  }
   state.counters["camera_shift_px"] = frame.camera_shift;
 }
-BENCHMARK(BM_PrepareDetailEnergy)->Arg(0)->Arg(10)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PrepareDetailEnergy)
+    ->Args({0, 0})
+    ->Args({10, 0})
+    ->Args({0, 1})
+    ->Args({10, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The detail stage's second term (energy.consensus.surface_weight: the refined mesh itself, each
 // sample moved with its face's corners): its reduced rows with their Jacobians where the stage
