@@ -76,7 +76,6 @@ FrameEnergy::FrameEnergy(SurfaceGaussians surface, const std::vector<CameraInput
 
 SampledInput FrameEnergy::TakeSampledInput(std::unique_ptr<FrameEnergy> energy) {
   // The terms read the samples and the cameras: they go first.
-  energy->last_pass_terms_.clear();
   energy->data_terms_.clear();
   SampledInput input;
   input.samples = std::move(energy->samples_);

@@ -155,11 +155,15 @@ std::vector<Eigen::Vector2d> AlignCameras(const Eigen::Matrix3Xd& points, int ma
     double largest = 0.0;
     for (int c = 0; c < num_cameras; ++c) {
       largest = std::max(largest, steps[c].norm());
-      (*cameras)[c].camera.K(0, 2) += steps[c].x();
-      (*cameras)[c].camera.K(1, 2) += steps[c].y();
       shifts[c] += steps[c];
     }
     if (largest < kAlignmentTolerancePixels) break;
+  }
+  // The rounds read at the pixels projected once, moved by the shifts: the calibrations change
+  // only now.
+  for (int c = 0; c < num_cameras; ++c) {
+    (*cameras)[c].camera.K(0, 2) += shifts[c].x();
+    (*cameras)[c].camera.K(1, 2) += shifts[c].y();
   }
   return shifts;
 }
