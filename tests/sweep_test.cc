@@ -131,5 +131,50 @@ TEST(SweepTest, SweepOffStartsEveryGaussianAtZero) {
   EXPECT_TRUE(SweepInitialization(&energy, sweep).isZero(0.0));
 }
 
+// Around k = 0 over the whole range, with the plane sweep's samples, smoothing and no window, the
+// detail stage's sweep is the plane sweep: the same costs (each term's block costs at uniform
+// displacements), the same choice.
+TEST(SweepAroundTest, AroundTheInputOverTheWholeRangeIsThePlaneSweep) {
+  const EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  const EnergyOptions options = SweepEnergyOptions(SimilarityType::kConsensus);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+  SweepOptions sweep;
+  sweep.samples = 9;
+  sweep.max_step_sigmas = 0.0;
+  sweep.window_sigmas = 0.0;
+  sweep.smoothing_rounds = 2;
+  const Eigen::VectorXd planes = SweepInitialization(&energy, sweep);
+  const Eigen::VectorXd around =
+      SweepAround(&energy, Eigen::VectorXd::Zero(energy.num_parameters()), options.k_max,
+                  2.0 * options.k_max / (sweep.samples - 1), sweep.smoothing_rounds);
+  EXPECT_GT(planes.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_TRUE(around.isApprox(planes, 1e-12)) << around.transpose() << "\n" << planes.transpose();
+}
+
+// Each Gaussian moves from its own start by at most the range and half a step (the parabola's
+// vertex lies within half a step of the lowest sample), and a Gaussian with no cost curve (one
+// camera: the consensus has no block) stays where it starts.
+TEST(SweepAroundTest, EachGaussianMovesFromItsStartByAtMostTheRange) {
+  const EnergyOptions options = SweepEnergyOptions(SimilarityType::kConsensus);
+  const double range = 0.002, step = 0.0005;
+  for (const int cameras : {1, 3}) {
+    const std::vector<double> tilts =
+        cameras == 1 ? std::vector<double>{0.3} : std::vector<double>{0.0, 0.6, -0.4};
+    const EnergyScene scene = MakeEnergyScene(tilts, 2, 5);
+    FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods, options);
+    const int n = energy.num_parameters();
+    const Eigen::VectorXd start = 0.004 * Eigen::VectorXd::LinSpaced(n, -1.0, 1.0);
+    const Eigen::VectorXd moved = SweepAround(&energy, start, range, step, 1);
+    ASSERT_EQ(moved.size(), n);
+    const double largest = (moved - start).cwiseAbs().maxCoeff();
+    if (cameras == 1) {
+      EXPECT_EQ(largest, 0.0);
+    } else {
+      EXPECT_GT(largest, 0.0);
+      EXPECT_LE(largest, range + 0.5 * step + 1e-15);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace finecap

@@ -501,6 +501,20 @@ void TakeTheFrameBefore(const FrameInput& input, FrameEnergy* energy) {
   energy->TakeFrameBefore(energy->UnknownsAtVertices(input.frame_before_k));
 }
 
+// Where the detail stage's first pass starts when the surface Gaussians' stage ended at `k`: the
+// best displacement nearby at the images' own resolution (SweepAround), or `k` with the sweep off
+// or no iteration asked for (a solve of none moves nothing).
+Eigen::VectorXd DetailSweep(const RefineOptions& options, FrameEnergy* energy,
+                            const Eigen::VectorXd& k) {
+  const SweepOptions& sweep = options.sweep;
+  if (sweep.samples == 0 || sweep.detail_range_sigmas <= 0.0 || options.solver.max_iterations == 0)
+    return k;
+  const double sigma_hat = energy->surface().sigma_hat;
+  return SweepAround(energy, k, sweep.detail_range_sigmas * sigma_hat,
+                     sweep.detail_step_sigmas * sigma_hat,
+                     SmoothingRoundsAt(options, sweep.smoothing_rounds));
+}
+
 // The detail stage (PrepareDetailEnergy) of `frame`, whose surface Gaussians' stage ended at
 // `*k`, solved in ConsensusOptions::passes passes from there; `*k` ends where it ends. With
 // RefineOptions::views_follow_surface each pass after the first is prepared anew at the surface
@@ -516,6 +530,7 @@ SolverSummary SolveDetailStage(const SequenceModel& model, const FrameInput& inp
     TakeTheFrameBefore(input, frame->energy.get());
   };
   prepare_at_k();
+  *k = DetailSweep(options, frame->energy.get(), *k);
   if (!options.views_follow_surface) {
     return SolveFrameEnergy(frame->energy.get(), options, k, /*measure_ends=*/false);
   }

@@ -112,6 +112,17 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
                 "its narrowest halving, down to model.sigma_hat, in whose outer half fewer than "
                 "this share of its surface Gaussians finds its lowest cost (0: never narrow).",
                 0.0, 1.0);
+    f.AddDouble("detail_range_sigmas", &SweepOptions::detail_range_sigmas,
+                "Detail stage: before its first pass each surface Gaussian tries displacements "
+                "within this many model.sigma_hat of where the surface Gaussians' stage left it, "
+                "read at the images' own resolution, and starts from the lowest of their costs "
+                "averaged over its neighbours (smoothing_rounds); 0, samples 0 or "
+                "solver.max_iterations 0: off.",
+                0.0, 16.0);
+    f.AddDouble("detail_step_sigmas", &SweepOptions::detail_step_sigmas,
+                "Detail stage's sweep: the displacements tried are at most this many "
+                "model.sigma_hat apart.",
+                0.01, 4.0);
     return f;
   }();
   return fields;

@@ -11,9 +11,23 @@ namespace finecap {
 
 namespace {
 
-// costs(s, j): the data cost of Gaussian s at displacement j, summed over the data terms that
-// offer sweep costs (SweepCosts).
-Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& displacements) {
+// costs(b, j): DataTerm::BlockCosts' costs[b] with every unknown moved by displacements[j]
+// from `base`.
+void BlockCostsAround(DataTerm* term, const Eigen::VectorXd& base,
+                      const Eigen::VectorXd& displacements, Eigen::MatrixXd* costs) {
+  costs->resize(static_cast<Eigen::Index>(term->residual_blocks().size()), displacements.size());
+  std::vector<double> block_costs;
+  for (int j = 0; j < displacements.size(); ++j) {
+    term->BlockCosts((base.array() + displacements[j]).matrix(), &block_costs);
+    costs->col(j) = Eigen::Map<const Eigen::VectorXd>(block_costs.data(), costs->rows());
+  }
+}
+
+// costs(s, j): the data cost of Gaussian s with every Gaussian at displacement j, or, with a
+// `base`, moved by displacement j from it, summed over the data terms that offer sweep costs
+// (SweepCosts).
+Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& displacements,
+                                 const Eigen::VectorXd* base = nullptr) {
   const int n = energy->num_parameters();
   Eigen::MatrixXd costs = Eigen::MatrixXd::Zero(n, displacements.size());
   Eigen::MatrixXd block_costs;
@@ -21,7 +35,11 @@ Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& dis
     DataTerm& term = energy->data_term(t);
     SweepCosts* sweep = term.sweep_costs();
     if (sweep == nullptr) continue;
-    sweep->UniformBlockCosts(n, displacements, &block_costs);
+    if (base == nullptr) {
+      sweep->UniformBlockCosts(n, displacements, &block_costs);
+    } else {
+      BlockCostsAround(&term, *base, displacements, &block_costs);
+    }
     const auto& blocks = term.residual_blocks();
     // Blocks may share a Gaussian (the paper's similarity): summed in one thread.
     for (int j = 0; j < displacements.size(); ++j) {
@@ -44,6 +62,19 @@ Eigen::VectorXd SweepDisplacements(const SweepOptions& options, double k_max, do
                        1 + 2 * static_cast<int>(std::min(half, 0.5 * SweepOptions::kMaxSamples)));
   }
   return Eigen::VectorXd::LinSpaced(samples, -k_max, k_max);
+}
+
+// The position of a cost curve's lowest sample `best` (of `displacements`, evenly spaced) refined
+// to the vertex of the parabola through it and its neighbours.
+double SubSamplePosition(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
+                         const Eigen::VectorXd& displacements, int best) {
+  const int last = static_cast<int>(displacements.size()) - 1;
+  if (best == 0 || best == last) return displacements[best];
+  const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
+  const double curvature = c0 - 2.0 * c1 + c2;
+  if (!(curvature > 0.0)) return displacements[best];
+  const double step = displacements[1] - displacements[0];
+  return displacements[best] + 0.5 * step * (c0 - c2) / curvature;
 }
 
 // The distance within which all but `share` of `distances` lie: its largest entry with fewer than
@@ -100,7 +131,6 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   const double window = options.window_sigmas > 0.0 ? options.window_sigmas * sigma_hat : k_max;
   Eigen::MatrixXd costs = CostsPerGaussian(energy, displacements);
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
-  const double step = displacements[1] - displacements[0];
   const int last = static_cast<int>(displacements.size()) - 1;
   int at_ends = 0;
   std::vector<double> confident_starts;  // |k| of the confident Gaussians.
@@ -112,13 +142,7 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
     // Where the images cannot decide k a curve at an end says nothing of the range.
     const bool confident = energy->confidence().size() != n || energy->confidence()[s] >= 0.5;
     at_ends += confident && (best == 0 || best == last);
-    result.k[s] = displacements[best];
-    // Sub-sample position: the vertex of the parabola through the best sample and its neighbours.
-    if (best > 0 && best < last) {
-      const double c0 = costs(s, best - 1), c1 = costs(s, best), c2 = costs(s, best + 1);
-      const double curvature = c0 - 2.0 * c1 + c2;
-      if (curvature > 0.0) result.k[s] += 0.5 * step * (c0 - c2) / curvature;
-    }
+    result.k[s] = SubSamplePosition(costs.row(s), displacements, best);
     if (confident) confident_starts.push_back(std::abs(result.k[s]));
   }
   result.share_at_ends = static_cast<double>(at_ends) / n;
@@ -128,6 +152,24 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
 
 Eigen::VectorXd SweepInitialization(FrameEnergy* energy, const SweepOptions& options) {
   return Sweep(energy, options).k;
+}
+
+Eigen::VectorXd SweepAround(FrameEnergy* energy, const Eigen::VectorXd& k, double range,
+                            double step, int smoothing_rounds) {
+  Require(range > 0.0 && step > 0.0, "SweepAround", "range and step must be positive");
+  const int half = static_cast<int>(std::ceil(range / step - 1e-9));
+  const Eigen::VectorXd offsets = Eigen::VectorXd::LinSpaced(2 * half + 1, -range, range);
+  Eigen::MatrixXd costs = CostsPerGaussian(energy, offsets, &k);
+  energy->regularizer().AverageOverNeighbours(smoothing_rounds, &costs);
+  const double bound = energy->layout().bound;
+  Eigen::VectorXd moved = k;
+  for (int s = 0; s < moved.size(); ++s) {
+    if (costs.row(s).minCoeff() == costs.row(s).maxCoeff()) continue;
+    int best = 0;
+    costs.row(s).minCoeff(&best);
+    moved[s] = std::clamp(k[s] + SubSamplePosition(costs.row(s), offsets, best), -bound, bound);
+  }
+  return moved;
 }
 
 }  // namespace finecap
