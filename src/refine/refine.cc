@@ -512,7 +512,7 @@ Eigen::VectorXd DetailSweep(const RefineOptions& options, FrameEnergy* energy,
   const double sigma_hat = energy->surface().sigma_hat;
   return SweepAround(energy, k, sweep.detail_range_sigmas * sigma_hat,
                      sweep.detail_step_sigmas * sigma_hat,
-                     SmoothingRoundsAt(options, sweep.smoothing_rounds));
+                     SmoothingRoundsAt(options, sweep.detail_smoothing_rounds));
 }
 
 // The detail stage (PrepareDetailEnergy) of `frame`, whose surface Gaussians' stage ended at

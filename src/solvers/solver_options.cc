@@ -116,13 +116,17 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
                 "Detail stage: before its first pass each surface Gaussian tries displacements "
                 "within this many model.sigma_hat of where the surface Gaussians' stage left it, "
                 "read at the images' own resolution, and starts from the lowest of their costs "
-                "averaged over its neighbours (smoothing_rounds); 0, samples 0 or "
+                "averaged over its neighbours (detail_smoothing_rounds); 0, samples 0 or "
                 "solver.max_iterations 0: off.",
                 0.0, 16.0);
     f.AddDouble("detail_step_sigmas", &SweepOptions::detail_step_sigmas,
                 "Detail stage's sweep: the displacements tried are at most this many "
                 "model.sigma_hat apart.",
                 0.01, 4.0);
+    f.AddInt("detail_smoothing_rounds", &SweepOptions::detail_smoothing_rounds,
+             "Detail stage's sweep: rounds of averaging its costs over mesh neighbours, counted "
+             "as smoothing_rounds are.",
+             0, 1000);
     return f;
   }();
   return fields;

@@ -69,12 +69,16 @@ struct SweepOptions {
   // Where the surface Gaussians' stage ends, the images hold detail finer than its Gaussians'
   // width, and the detail stage's solver, whose patches read the images at their own resolution,
   // only descends into the nearest of its minima; a few displacements tried around the start
-  // find the best one nearby (synth_skirt_exact 49.6 -> 49.9 %, synth_noisy 68.8 -> 70.2 %, the
-  // temple's held-out NCC 0.7236 -> 0.7251; docs/measurements.md). Wider is not better: 8
+  // find the best one nearby (synth_skirt_exact 49.6 -> 50.0 %, synth_noisy 68.8 -> 70.4 %, the
+  // temple's held-out NCC 0.7236 -> 0.7250; docs/measurements.md). Wider is not better: 8
   // sigma_hat each side starts many Gaussians at chance agreements of colour. Off (0) with
   // `samples` 0 or no solver iteration, so that an input scored as given stays as given.
   double detail_range_sigmas = 0.5;
   double detail_step_sigmas = 0.25;
+  // Rounds of averaging the detail sweep's costs over the neighbours, counted as
+  // `smoothing_rounds` are. Fewer than the plane sweep's: its displacements span a pixel or two,
+  // not the whole range, and the patches it costs read the images at their own resolution.
+  int detail_smoothing_rounds = 1;
 
   static const OptionFields<SweepOptions>& Fields();  // option_fields.h
   void Check() const;
