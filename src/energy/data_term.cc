@@ -40,14 +40,19 @@ Eigen::VectorXd DataTerm::GaussNewtonDiagonal(const Eigen::VectorXd& k) {
   return curvature;
 }
 
-void SummarisedDataTerm::UniformBlockCosts(int num_unknowns, const Eigen::VectorXd& displacements,
-                                           Eigen::MatrixXd* costs) {
+void DataTerm::BlockCostsAround(const Eigen::VectorXd& base, const Eigen::VectorXd& displacements,
+                                Eigen::MatrixXd* costs) {
   costs->resize(static_cast<Eigen::Index>(residual_blocks().size()), displacements.size());
   std::vector<double> block_costs;
   for (int j = 0; j < displacements.size(); ++j) {
-    BlockCosts(Eigen::VectorXd::Constant(num_unknowns, displacements[j]), &block_costs);
+    BlockCosts((base.array() + displacements[j]).matrix(), &block_costs);
     costs->col(j) = Eigen::Map<const Eigen::VectorXd>(block_costs.data(), costs->rows());
   }
+}
+
+void SummarisedDataTerm::UniformBlockCosts(int num_unknowns, const Eigen::VectorXd& displacements,
+                                           Eigen::MatrixXd* costs) {
+  BlockCostsAround(Eigen::VectorXd::Zero(num_unknowns), displacements, costs);
 }
 
 BlockSummary SummarisedDataTerm::Summarise(const double* residuals, const double* jacobian, int m) {

@@ -11,18 +11,6 @@ namespace finecap {
 
 namespace {
 
-// costs(b, j): DataTerm::BlockCosts' costs[b] with every unknown moved by displacements[j]
-// from `base`.
-void BlockCostsAround(DataTerm* term, const Eigen::VectorXd& base,
-                      const Eigen::VectorXd& displacements, Eigen::MatrixXd* costs) {
-  costs->resize(static_cast<Eigen::Index>(term->residual_blocks().size()), displacements.size());
-  std::vector<double> block_costs;
-  for (int j = 0; j < displacements.size(); ++j) {
-    term->BlockCosts((base.array() + displacements[j]).matrix(), &block_costs);
-    costs->col(j) = Eigen::Map<const Eigen::VectorXd>(block_costs.data(), costs->rows());
-  }
-}
-
 // costs(s, j): the data cost of Gaussian s with every Gaussian at displacement j, or, with a
 // `base`, moved by displacement j from it, summed over the data terms that offer sweep costs
 // (SweepCosts).
@@ -38,7 +26,7 @@ Eigen::MatrixXd CostsPerGaussian(FrameEnergy* energy, const Eigen::VectorXd& dis
     if (base == nullptr) {
       sweep->UniformBlockCosts(n, displacements, &block_costs);
     } else {
-      BlockCostsAround(&term, *base, displacements, &block_costs);
+      term.BlockCostsAround(*base, displacements, &block_costs);
     }
     const auto& blocks = term.residual_blocks();
     // Blocks may share a Gaussian (the paper's similarity): summed in one thread.

@@ -76,6 +76,10 @@ class DataTerm {
   // costs[b] = the sum of squares of block b's residuals at k, for every block. Prepares the
   // residuals at k (without Jacobians) and sums them; a term may know a faster way.
   virtual void BlockCosts(const Eigen::VectorXd& k, std::vector<double>* costs);
+  // costs(b, j) = BlockCosts' costs[b] with every unknown moved by displacements[j] from `base`:
+  // a term's value along a family of surfaces parallel to `base`.
+  void BlockCostsAround(const Eigen::VectorXd& base, const Eigen::VectorXd& displacements,
+                        Eigen::MatrixXd* costs);
 
   // H_s = the sum over the residuals r of (dr/dk_s)^2 at k, one entry per unknown (the diagonal
   // of the Gauss-Newton J^T J). Prepares the residuals with Jacobians
