@@ -49,40 +49,50 @@ rm -rf "$work/run" "$work/openmvs" "$work"/input* "$work"/scored*
 
 [ -x build/finecap ] || bash scripts/build.sh >/dev/null
 
-# score_as_given MESH DIR NAME: prints NAME_heldout_ncc and NAME_heldout_mad of MESH as given,
-# scored in the held-out views as the input of a capture at DIR (symlinks to the cameras and
-# images; nothing is written into the capture) refined with no subdivision, iteration or sweep.
+# capture_with_mesh MESH DIR: a capture at DIR of the cameras and images of $capture (symlinks;
+# nothing is written into the capture) with MESH as its mesh.
+capture_with_mesh() {
+  mkdir -p "$2/meshes"
+  ln -s "$capture/cameras.yaml" "$2/cameras.yaml"
+  ln -s "$capture/images" "$2/images"
+  cp "$1" "$2/meshes/000000.ply"
+}
+
+# seconds_since START: wall time from START (date +%s.%N) to now, one decimal.
+seconds_since() {
+  awk -v e="$(date +%s.%N)" -v s="$1" 'BEGIN { printf "%.1f", e - s }'
+}
+
+# score_as_given MESH DIR NAME: prints NAME_heldout_ncc and NAME_heldout_mad of MESH as given:
+# the input of a capture at DIR (capture_with_mesh), refined with no subdivision, iteration or
+# sweep; the refine run's own record holds the held-out score of its input.
 score_as_given() {
   local mesh=$1 dir=$2 name=$3
-  mkdir -p "$dir/meshes"
-  ln -s "$capture/cameras.yaml" "$dir/cameras.yaml"
-  ln -s "$capture/images" "$dir/images"
-  cp "$mesh" "$dir/meshes/000000.ply"
-  local as_given=(--config "$capture/heldout.yaml" --capture "$dir" --out "$dir.run")
-  local unchanged=model.subdivision_levels=0,solver.max_iterations=0,refine.sweep.samples=0
-  build/finecap refine "${as_given[@]}" --set "$unchanged" >/dev/null 2>"$dir.refine.log"
-  build/finecap eval "${as_given[@]}" --set "$unchanged,eval.flow=none" >/dev/null \
-    2>"$dir.eval.log"
-  python3 - "$dir.run/eval/metrics.json" "$name" <<'PY'
+  capture_with_mesh "$mesh" "$dir"
+  build/finecap refine --config "$capture/heldout.yaml" --capture "$dir" --out "$dir.run" \
+    --set model.subdivision_levels=0,solver.max_iterations=0,refine.sweep.samples=0 \
+    >/dev/null 2>"$dir.refine.log"
+  python3 - "$dir.run/stats.jsonl" "$name" <<'PY'
 import json, sys
-metrics = json.load(open(sys.argv[1]))
-print(f"{sys.argv[2]}_heldout_ncc: {metrics['heldout_ncc_input']:.4f}")
-print(f"{sys.argv[2]}_heldout_mad: {metrics['heldout_mad_input']:.4f}")
+record = json.loads(open(sys.argv[1]).readline())
+print(f"{sys.argv[2]}_heldout_ncc: {record['heldout_ncc_input']:.4f}")
+print(f"{sys.argv[2]}_heldout_mad: {record['heldout_mad_input']:.4f}")
 PY
 }
+
 # One --set each: of several, finecap keeps the last.
 args=(--config "$capture/heldout.yaml" --capture "$capture" --out "$work/run")
 /usr/bin/time -f "%e %M" -o "$work/refine.time" \
   build/finecap refine "${args[@]}" --set "${SET:-}" >/dev/null 2>"$work/refine.log"
 start=$(date +%s.%N)
 build/finecap eval "${args[@]}" --set "eval.flow=none${SET:+,$SET}" >/dev/null 2>"$work/eval.log"
-end=$(date +%s.%N)
+eval_seconds=$(seconds_since "$start")
 
 python3 bench/heldout_figures.py "$work/run"
 read -r seconds kilobytes < "$work/refine.time"
 echo "refine_seconds: $seconds"
 echo "refine_peak_mb: $((kilobytes / 1024))"
-echo "eval_seconds: $(awk -v e="$end" -v s="$start" 'BEGIN { printf "%.1f", e - s }')"
+echo "eval_seconds: $eval_seconds"
 score_as_given "$capture/meshes/000000.ply" "$work/input" input_as_given
 score_as_given "$work/run/meshes/000000.ply" "$work/scored" refined_as_given
 
@@ -130,24 +140,21 @@ start=$(date +%s.%N)
     --decimate 1 --max-face-area 0 --close-holes 0 --ensure-edge-size 0 \
     --planar-vertex-ratio 0 --max-threads 0 >refine.log 2>&1
 )
-end=$(date +%s.%N)
+openmvs_seconds=$(seconds_since "$start")
 [ -f "$mvs/refined.ply" ] || { echo "RefineMesh wrote no $mvs/refined.ply ($mvs/refine.log)" >&2; exit 1; }
 
 score_as_given "$mvs/refined.ply" "$mvs/scored" openmvs
-echo "openmvs_seconds: $(awk -v e="$end" -v s="$start" 'BEGIN { printf "%.1f", e - s }')"
+echo "openmvs_seconds: $openmvs_seconds"
 peak=$(cat "$mvs/interface.time" "$mvs/refine.time" | awk '$2 > m { m = $2 } END { print m }')
 echo "openmvs_peak_mb: $((peak / 1024))"
 
 # The two tools one after the other: finecap refining RefineMesh's mesh, from a capture whose
 # mesh it is (the held-out cameras still held out).
 after="$mvs/after"
-mkdir -p "$after/meshes"
-ln -s "$capture/cameras.yaml" "$after/cameras.yaml"
-ln -s "$capture/images" "$after/images"
-cp "$mvs/refined.ply" "$after/meshes/000000.ply"
+capture_with_mesh "$mvs/refined.ply" "$after"
 start=$(date +%s.%N)
 build/finecap refine --config "$capture/heldout.yaml" --capture "$after" --out "$after.run" \
   --set "${SET:-}" >/dev/null 2>"$after.log"
-end=$(date +%s.%N)
+after_seconds=$(seconds_since "$start")
 score_as_given "$after.run/meshes/000000.ply" "$mvs/after_scored" openmvs_then_finecap
-echo "openmvs_then_finecap_seconds: $(awk -v e="$end" -v s="$start" 'BEGIN { printf "%.1f", e - s }')"
+echo "openmvs_then_finecap_seconds: $after_seconds"
