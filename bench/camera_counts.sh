@@ -31,6 +31,7 @@ captures=(
   "synth_skirt configs/synth_skirt.yaml synth.fold_ramp_frames=0"
   "synth_demo configs/synth_demo.yaml synth.fold_ramp_frames=0"
   "synth_skirt_smoothed configs/synth_skirt_smoothed.yaml synth.fold_ramp_frames=0"
+  "synth_skirt_print configs/synth_skirt.yaml synth.fold_ramp_frames=0,synth.texture.pattern=print"
 )
 
 results=$work/results.tsv

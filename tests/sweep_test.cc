@@ -95,6 +95,71 @@ TEST(WindowedMinimumTest, ACostFallingToTheRangesEndStopsThere) {
   EXPECT_EQ(WindowedMinimum((-costs).eval(), k, 0.5), 0);
 }
 
+// The window's half-width at the end of the search: the first window, or the one it doubled to.
+TEST(WindowedMinimumTest, TellsTheWindowItSearched) {
+  const Eigen::VectorXd k = Displacements();
+  double searched = 0.0;
+  WindowedMinimum((k.array() - 1.0).square().matrix().transpose(), k, 2.0, &searched);
+  EXPECT_DOUBLE_EQ(searched, 2.0);
+  WindowedMinimum((k.array() - 6.0).square().matrix().transpose(), k, 2.0, &searched);
+  EXPECT_DOUBLE_EQ(searched, 8.0);
+}
+
+// Two minima of a pattern that matches itself, at -4 and 4: as deep, neither stands out; the
+// other one shallower by half the curve's median height, half; much shallower, 1.
+TEST(CostUniquenessTest, ARivalMinimumAsDeepLeavesNoUniqueness) {
+  const Eigen::VectorXd k = Displacements();
+  const auto curve = [&](double rival_depth) -> Eigen::RowVectorXd {
+    return (1.0 - Eigen::exp(-(k.array() + 4.0).square()) -
+            rival_depth * Eigen::exp(-(k.array() - 4.0).square()))
+        .matrix()
+        .transpose();
+  };
+  const int chosen = 4;  // k = -4.
+  EXPECT_NEAR(CostUniqueness(curve(1.0), k, chosen, 2.0, 8.0), 0.0, 1e-12);
+  // The curve's median is about 1 (most samples lie far from both minima), its own cost 0.
+  EXPECT_NEAR(CostUniqueness(curve(0.5), k, chosen, 2.0, 8.0), 0.5, 0.01);
+  EXPECT_GT(CostUniqueness(curve(0.0), k, chosen, 2.0, 8.0), 0.99);
+}
+
+// A rival outside the window the start was searched in does not count (the windowed search keeps
+// a nearer minimum on purpose), nor one closer than `distinct` (the same minimum's flanks); with
+// nothing left to compare, the start is unique.
+TEST(CostUniquenessTest, OnlyDistinctRivalsInsideTheSearchedWindowCount) {
+  const Eigen::VectorXd k = Displacements();
+  const Eigen::RowVectorXd costs =
+      (1.0 - Eigen::exp(-(k.array() + 1.0).square()) - Eigen::exp(-(k.array() - 6.0).square()))
+          .matrix()
+          .transpose();
+  const int chosen = 7;  // k = -1.
+  EXPECT_NEAR(CostUniqueness(costs, k, chosen, 2.0, 8.0), 0.0, 1e-12);
+  EXPECT_GT(CostUniqueness(costs, k, chosen, 2.0, 4.0), 0.9);
+  EXPECT_DOUBLE_EQ(CostUniqueness(costs, k, chosen, 20.0, 8.0), 1.0);
+}
+
+// A curve flat at its lowest over half its samples or more says nothing of where the surface is.
+TEST(CostUniquenessTest, ACurveLowOverHalfItsSamplesIsAmbiguous) {
+  const Eigen::VectorXd k = Displacements();
+  Eigen::RowVectorXd costs = Eigen::RowVectorXd::Zero(k.size());
+  costs.head(5).setConstant(1.0);
+  EXPECT_DOUBLE_EQ(CostUniqueness(costs, k, 10, 2.0, 8.0), 0.0);
+}
+
+// Every Gaussian gets a uniqueness in [0, 1], those without a cost curve 1.
+TEST(SweepTest, UniquenessLiesBetweenZeroAndOne) {
+  const EnergyScene scene = MakeEnergyScene({0.0, 0.6, -0.4}, 2, 3);
+  FrameEnergy energy(scene.surface, scene.cameras, scene.neighbourhoods,
+                     SweepEnergyOptions(SimilarityType::kConsensus));
+  const SweepResult result = Sweep(&energy, SweepOptions());
+  ASSERT_EQ(result.uniqueness.size(), energy.num_parameters());
+  EXPECT_GE(result.uniqueness.minCoeff(), 0.0);
+  EXPECT_LE(result.uniqueness.maxCoeff(), 1.0);
+  const EnergyScene lone = MakeEnergyScene({0.3}, 2, 7);  // One camera: no cost curve at all.
+  FrameEnergy lone_energy(lone.surface, lone.cameras, lone.neighbourhoods,
+                          SweepEnergyOptions(SimilarityType::kConsensus));
+  EXPECT_TRUE(Sweep(&lone_energy, SweepOptions()).uniqueness.isOnes(0.0));
+}
+
 // The share of Gaussians the range limits counts those whose start is at an end of the range:
 // with the range so narrow that the costs cannot turn (one sample each side of 0 and the input
 // off by more), some are; with a wide range fewer. The sweep's reach, which says whether a range

@@ -213,6 +213,26 @@ double NextRange(const SweepResult& start, double k_max, double sigma_hat, int c
   return range;
 }
 
+// Puts back at the input (k = 0) the start of every surface Gaussian of `surface` that at most
+// two of `cameras` see within visibility.max_view_angle_deg and whose sweep costs single out none
+// of its displacements (SweepOptions::min_uniqueness).
+void StartAmbiguousTwoViewGaussiansAtInput(const SurfaceGaussians& surface,
+                                           const std::vector<CameraInput>& cameras,
+                                           const RefineOptions& options, SweepResult* start) {
+  if (options.sweep.min_uniqueness == 0.0 || start->uniqueness.size() != surface.size()) return;
+  const double min_cosine = std::cos(options.visibility.max_view_angle_deg * M_PI / 180.0);
+  for (int s = 0; s < surface.size(); ++s) {
+    if (!(start->uniqueness[s] < options.sweep.min_uniqueness)) continue;
+    int frontal = 0;
+    for (const CameraInput& camera : cameras) {
+      frontal +=
+          camera.visible[s] != 0 &&
+          camera.camera.ViewCosine(surface.base.col(s), surface.normals.col(s)) >= min_cosine;
+    }
+    if (frontal <= 2) start->k[s] = 0.0;
+  }
+}
+
 // Builds the energy of `surface` over `cameras` and, when `sweep`, finds the plane sweep's start
 // (frame->sweep_start), building the energy again over a wider or a narrower range while the
 // sweep says that the range limits it or is far wider than its Gaussians need (NextRange).
@@ -229,6 +249,7 @@ void BuildSweptEnergy(const SequenceModel& model, const SurfaceGaussians& surfac
     SweepResult start = Sweep(frame->energy.get(), SweepOptionsAt(options));
     const double next = NextRange(start, energy.k_max, surface.sigma_hat, changes, options.sweep);
     if (next == energy.k_max) {
+      StartAmbiguousTwoViewGaussiansAtInput(surface, cameras, options, &start);
       frame->sweep_start = std::move(start.k);
       return;
     }

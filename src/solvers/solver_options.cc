@@ -127,6 +127,13 @@ const OptionFields<SweepOptions>& SweepOptions::Fields() {
              "Detail stage's sweep: rounds of averaging its costs over mesh neighbours, counted "
              "as smoothing_rounds are.",
              0, 1000);
+    f.AddDouble("min_uniqueness", &SweepOptions::min_uniqueness,
+                "Plane-sweep start: a surface Gaussian that at most two cameras see within "
+                "visibility.max_view_angle_deg starts at the input instead of its lowest cost "
+                "when that stands out by less than this fraction of its curve's median height "
+                "above it against the lowest cost more than 2 model.sigma_hat away in its window "
+                "(curves averaged over neighbours as smoothing_rounds says; 0: never).",
+                0.0, 1.0);
     return f;
   }();
   return fields;

@@ -80,7 +80,8 @@ double Reach(std::vector<double>* distances, double share) {
 }  // namespace
 
 int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
-                    const Eigen::Ref<const Eigen::VectorXd>& displacements, double window) {
+                    const Eigen::Ref<const Eigen::VectorXd>& displacements, double window,
+                    double* searched) {
   const int n = static_cast<int>(costs.size());
   const double tolerance = 1e-9 * (displacements[n - 1] - displacements[0]);
   // The samples within `reach` of k = 0: [first, last].
@@ -91,6 +92,7 @@ int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
     while (*last > *first && displacements[*last] > reach + tolerance) --*last;
   };
   for (double reach = window;; reach *= 2.0) {
+    if (searched != nullptr) *searched = reach;
     int first = 0, last = 0;
     samples_within(reach, &first, &last);
     int best = 0;
@@ -107,6 +109,28 @@ int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
   }
 }
 
+double CostUniqueness(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
+                      const Eigen::Ref<const Eigen::VectorXd>& displacements, int chosen,
+                      double distinct, double searched) {
+  const double own = costs[chosen];
+  // As WindowedMinimum's: a sample at the window's edge is inside it.
+  const double tolerance = 1e-9 * (displacements[displacements.size() - 1] - displacements[0]);
+  double rival = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < costs.size(); ++j) {
+    if (std::abs(displacements[j] - displacements[chosen]) > distinct &&
+        std::abs(displacements[j]) <= searched + tolerance) {
+      rival = std::min(rival, costs[j]);
+    }
+  }
+  if (rival == std::numeric_limits<double>::infinity()) return 1.0;
+  std::vector<double> sorted(costs.begin(), costs.end());
+  const auto middle = sorted.begin() + sorted.size() / 2;
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  const double height = *middle - own;
+  if (!(height > 0.0)) return 0.0;
+  return std::clamp((rival - own) / height, 0.0, 1.0);
+}
+
 SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   options.Check();
   const int n = energy->num_parameters();
@@ -120,21 +144,28 @@ SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options) {
   Eigen::MatrixXd costs = CostsPerGaussian(energy, displacements);
   energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &costs);
   const int last = static_cast<int>(displacements.size()) - 1;
+  // One column: the uniqueness is averaged over the neighbours as the costs were.
+  Eigen::MatrixXd uniqueness = Eigen::MatrixXd::Ones(n, 1);
   int at_ends = 0;
   std::vector<double> confident_starts;  // |k| of the confident Gaussians.
   for (int s = 0; s < n; ++s) {
     // A Gaussian whose curve is flat (no block reaches it, nor its neighbours' costs) has no
     // best displacement: it stays where the coarse mesh puts it rather than at -k_max.
     if (costs.row(s).minCoeff() == costs.row(s).maxCoeff()) continue;
-    const int best = WindowedMinimum(costs.row(s), displacements, window);
+    double searched = 0.0;
+    const int best = WindowedMinimum(costs.row(s), displacements, window, &searched);
     // Where the images cannot decide k a curve at an end says nothing of the range.
     const bool confident = energy->confidence().size() != n || energy->confidence()[s] >= 0.5;
     at_ends += confident && (best == 0 || best == last);
     result.k[s] = SubSamplePosition(costs.row(s), displacements, best);
+    uniqueness(s, 0) = CostUniqueness(costs.row(s), displacements, best,
+                                      kDistinctMinimumSigmas * sigma_hat, searched);
     if (confident) confident_starts.push_back(std::abs(result.k[s]));
   }
   result.share_at_ends = static_cast<double>(at_ends) / n;
   result.reach = Reach(&confident_starts, options.narrow_share);
+  energy->regularizer().AverageOverNeighbours(options.smoothing_rounds, &uniqueness);
+  result.uniqueness = uniqueness.col(0);
   return result;
 }
 

@@ -79,6 +79,18 @@ struct SweepOptions {
   // `smoothing_rounds` are. Fewer than the plane sweep's: its displacements span a pixel or two,
   // not the whole range, and the patches it costs read the images at their own resolution.
   int detail_smoothing_rounds = 1;
+  // A surface Gaussian that at most two cameras see within VisibilityOptions::
+  // max_view_angle_deg starts at the input instead of at its best displacement when that
+  // displacement's uniqueness (SweepResult::uniqueness) is below this. Two cameras 90 degrees
+  // apart (a four-camera rig) see a printed or finely textured cloth match itself at several
+  // displacements, and a solve started at a chance one ends there: synth_skirt printed, four
+  // cameras, ended 6.9 % worse than its input over frames 0-2. With three cameras or more the
+  // others break such ties, and there a low uniqueness mostly means a wide range's far minima (the
+  // temple's visual hull), which the windowed search already passes by: the rule is not applied
+  // (applied to every Gaussian, the temple's held-out NCC fell from 0.725 to 0.711). Chosen between
+  // 0.3, after which one frame of the printed skirt stayed worse than its input, and 0.5, which
+  // cost the temple 0.004 (docs/measurements.md, 2026-12-07). 0: never.
+  double min_uniqueness = 0.4;
 
   static const OptionFields<SweepOptions>& Fields();  // option_fields.h
   void Check() const;
@@ -87,8 +99,19 @@ struct SweepOptions {
 // The sample Gaussian's window search chooses on its cost curve `costs` at `displacements`
 // (ascending): the lowest sample within `window` of k = 0, the window doubled while that sample
 // is at one of its ends and a sample up to twice as far beyond that end costs less.
+// `searched`, when not null, is set to the window's half-width at the end.
 int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
-                    const Eigen::Ref<const Eigen::VectorXd>& displacements, double window);
+                    const Eigen::Ref<const Eigen::VectorXd>& displacements, double window,
+                    double* searched = nullptr);
+
+// How clearly the displacement `chosen` stands out on the cost curve `costs` at `displacements`:
+// (c_2 - c_chosen) / (c_median - c_chosen), with c_2 the lowest cost of the samples more than
+// `distinct` away from it, clamped to [0, 1]. 0: another displacement, a distinct minimum, costs
+// as little (or less: the windowed search may keep a nearer one), or half the curve is as low; 1:
+// nothing else comes close, or no sample lies that far (nothing to confuse it with).
+double CostUniqueness(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
+                      const Eigen::Ref<const Eigen::VectorXd>& displacements, int chosen,
+                      double distinct, double searched);
 
 // A sweep's start and what it says about its range.
 struct SweepResult {
@@ -104,7 +127,15 @@ struct SweepResult {
   // cameras decide them all; infinite when there is none (nothing says that the range is too
   // wide).
   double reach = std::numeric_limits<double>::infinity();
+  // Per Gaussian, the CostUniqueness of its start on its smoothed cost curve, distinct minima
+  // kDistinctMinimumSigmas sigma_hat apart, averaged over the neighbours as the costs are
+  // (SweepOptions::smoothing_rounds); 1 where the curve is flat.
+  Eigen::VectorXd uniqueness;
 };
+
+// Two minima of a cost curve count as distinct this many sigma_hat apart: a surface Gaussian's
+// own minimum is about as wide as the Gaussian.
+constexpr double kDistinctMinimumSigmas = 2.0;
 
 SweepResult Sweep(FrameEnergy* energy, const SweepOptions& options);
 
