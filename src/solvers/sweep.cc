@@ -77,13 +77,18 @@ double Reach(std::vector<double>* distances, double share) {
   return *at;
 }
 
+// How far past a window's edge a displacement still counts as inside it: LinSpaced's rounding.
+double EdgeTolerance(const Eigen::Ref<const Eigen::VectorXd>& displacements) {
+  return 1e-9 * (displacements[displacements.size() - 1] - displacements[0]);
+}
+
 }  // namespace
 
 int WindowedMinimum(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
                     const Eigen::Ref<const Eigen::VectorXd>& displacements, double window,
                     double* searched) {
   const int n = static_cast<int>(costs.size());
-  const double tolerance = 1e-9 * (displacements[n - 1] - displacements[0]);
+  const double tolerance = EdgeTolerance(displacements);
   // The samples within `reach` of k = 0: [first, last].
   const auto samples_within = [&](double reach, int* first, int* last) {
     *first = 0;
@@ -113,8 +118,7 @@ double CostUniqueness(const Eigen::Ref<const Eigen::RowVectorXd>& costs,
                       const Eigen::Ref<const Eigen::VectorXd>& displacements, int chosen,
                       double distinct, double searched) {
   const double own = costs[chosen];
-  // As WindowedMinimum's: a sample at the window's edge is inside it.
-  const double tolerance = 1e-9 * (displacements[displacements.size() - 1] - displacements[0]);
+  const double tolerance = EdgeTolerance(displacements);
   double rival = std::numeric_limits<double>::infinity();
   for (int j = 0; j < costs.size(); ++j) {
     if (std::abs(displacements[j] - displacements[chosen]) > distinct &&
