@@ -35,11 +35,12 @@ bool IsConfigLevelKey(const std::string& path) {
 }
 
 // Keys whose lower bound is another key's value (Check() refuses a hem narrower than the waist, a
-// fallback view angle below the view-angle cap):
+// fallback view or pair angle below its cap):
 // only their fixed bounds are walked.
 bool LowerBoundFollowsAnotherKey(const std::string& path) {
   return path == "synth.skirt.hem_radius" || path == "synth.texture.textureless_end" ||
-         path == "visibility.fallback_view_angle_deg";
+         path == "visibility.fallback_view_angle_deg" ||
+         path == "visibility.fallback_pair_angle_deg";
 }
 
 // The key that the failing field of config.Check() belongs to; "" when the check passes.

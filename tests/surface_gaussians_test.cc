@@ -127,6 +127,30 @@ TEST_F(FrontalViewsTest, ConfidenceFollowsTheWantedCamerasAngle) {
   EXPECT_FLOAT_EQ(Confidence(2), 0.0f) << "no fallback: a view beyond the cap counts for nothing";
 }
 
+// The point at the origin seen by cameras at `tilts` (radians about it, all within 60 degrees of
+// its normal), two of them wanted.
+float PairedConfidence(const std::vector<double>& tilts, const VisibilityOptions& options = {}) {
+  std::vector<Camera> cameras;
+  for (double tilt : tilts) cameras.push_back(LookAtOrigin(1.0, tilt, 400.0, 100));
+  const std::vector<std::vector<unsigned char>> visible(tilts.size(), {1});
+  return ViewConfidence(cameras, Eigen::Matrix3Xd::Zero(3, 1),
+                        Eigen::Matrix3Xd(Eigen::Vector3d(0.0, 0.0, -1.0)), 2, options, visible)[0];
+}
+
+TEST(PairConfidenceTest, TwoCamerasFarApartCountForLess) {
+  const double full = std::cos(105.0 * M_PI / 180.0), none = std::cos(120.0 * M_PI / 180.0);
+  EXPECT_FLOAT_EQ(PairedConfidence({-0.785, 0.785}), 1.0f) << "90 degrees apart";
+  EXPECT_FLOAT_EQ(PairedConfidence({-1.0, 1.0}),
+                  static_cast<float>((std::cos(2.0) - none) / (full - none)))
+      << "115 degrees apart";
+  EXPECT_FLOAT_EQ(PairedConfidence({-1.2, 1.2}), 0.0f) << "138 degrees: beyond the fallback";
+  EXPECT_FLOAT_EQ(PairedConfidence({-1.0, 0.0, 1.0}), 1.0f)
+      << "a third camera between them makes a narrow pair";
+  VisibilityOptions any_pair;
+  any_pair.max_pair_angle_deg = any_pair.fallback_pair_angle_deg = 180.0;
+  EXPECT_FLOAT_EQ(PairedConfidence({-1.0, 1.0}, any_pair), 1.0f);
+}
+
 TEST(ReferenceColorsTest, WrongVertexCountAndTruncationAreNamed) {
   const std::string path = TempPath("colors_count.txt");
   WriteReferenceColors(path, SomeColors());

@@ -236,8 +236,9 @@ void PrintConfidence(double confident_share) {
                "few cameras, only at steep angles, or plain, stay near the input\n";
   if (confident_share < kUsefulConfidentShare) {
     std::cout << "Too few views for this capture to be refined usefully: only " << percent
-              << " % of its surface is seen well enough by enough cameras (visibility.*, "
-                 "energy.consensus.min_cameras); the rest is kept near the input\n";
+              << " % of its surface is seen well enough by enough cameras near enough to each "
+                 "other (visibility.*, energy.consensus.min_cameras); the rest is kept near the "
+                 "input\n";
   }
 }
 

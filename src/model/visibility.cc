@@ -23,6 +23,16 @@ const OptionFields<VisibilityOptions>& VisibilityOptions::Fields() {
                 "compares takes the most frontal up to this angle, with less confidence; equal to "
                 "max_view_angle_deg: none.",
                 1.0, 90.0);
+    f.AddDouble("max_pair_angle_deg", &VisibilityOptions::max_pair_angle_deg,
+                "Widest angle between two cameras' directions to a vertex at which their "
+                "agreement still counts fully towards its confidence (the narrowest pair of the "
+                "cameras that see it).",
+                1.0, 180.0);
+    f.AddDouble("fallback_pair_angle_deg", &VisibilityOptions::fallback_pair_angle_deg,
+                "Angle between two cameras' directions to a vertex at which their agreement no "
+                "longer counts towards its confidence (falling from max_pair_angle_deg); equal to "
+                "it: a sharp cut; both 180: any pair counts.",
+                1.0, 180.0);
     f.AddDouble("sample_view_angle_deg", &VisibilityOptions::sample_view_angle_deg,
                 "Largest angle between a normal of the surface the surface Gaussians found and "
                 "the direction to a camera whose pixels the detail stage reads "
@@ -42,6 +52,9 @@ void VisibilityOptions::Check() const {
   internal::RequireFieldRange(fallback_view_angle_deg, max_view_angle_deg,
                               Fields().Field("fallback_view_angle_deg").max,
                               "VisibilityOptions::fallback_view_angle_deg");
+  internal::RequireFieldRange(fallback_pair_angle_deg, max_pair_angle_deg,
+                              Fields().Field("fallback_pair_angle_deg").max,
+                              "VisibilityOptions::fallback_pair_angle_deg");
 }
 
 namespace {
@@ -127,6 +140,25 @@ void DropSteepViews(const char* caller, const std::vector<Camera>& cameras,
   }
 }
 
+// How much the narrowest pair of `views` (at least two) counts, in [0, 1]: 1 when two of them are
+// within `full` (a cosine) of each other as seen from `point`, falling linearly in the cosine to 0
+// at `none`.
+double PairConfidence(const std::vector<Camera>& cameras, const Eigen::Vector3d& point,
+                      const std::vector<std::pair<double, int>>& views, double full, double none) {
+  std::vector<Eigen::Vector3d> directions;
+  for (const auto& view : views) {
+    directions.push_back((cameras[view.second].Center() - point).normalized());
+  }
+  double narrowest = -1.0;  // The largest cosine between two directions.
+  for (size_t i = 0; i < directions.size(); ++i) {
+    for (size_t j = i + 1; j < directions.size(); ++j) {
+      narrowest = std::max(narrowest, directions[i].dot(directions[j]));
+    }
+  }
+  if (narrowest >= full) return 1.0;
+  return full > none ? std::max(0.0, (narrowest - none) / (full - none)) : 0.0;
+}
+
 }  // namespace
 
 void KeepFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matrix3Xd& points,
@@ -151,6 +183,8 @@ std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
           "at least one wanted camera and one flag list per camera");
   const double full = CosineOf(options.max_view_angle_deg);
   const double none = CosineOf(options.fallback_view_angle_deg);
+  const double pair_full = CosineOf(options.max_pair_angle_deg);
+  const double pair_none = CosineOf(options.fallback_pair_angle_deg);
   const int n = static_cast<int>(points.cols());
   std::vector<float> confidence(n, 0.0f);
 #pragma omp parallel for schedule(static)
@@ -162,6 +196,10 @@ std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
       confidence[p] = 1.0f;
     } else if (full > none) {  // Without a fallback (the two angles equal) a steeper view is 0.
       confidence[p] = static_cast<float>(std::max(0.0, (cosine - none) / (full - none)));
+    }
+    if (wanted >= 2) {
+      confidence[p] *=
+          static_cast<float>(PairConfidence(cameras, points.col(p), views, pair_full, pair_none));
     }
   }
   return confidence;

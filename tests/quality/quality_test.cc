@@ -144,6 +144,10 @@ TEST(QualityTest, SkirtWithFoldsInFrameZeroRecoversTheDetail) {
 // confidence pull all three ended worse than their input (-0.0 %, -7.0 %, -1.9 %). The printed
 // skirt on 4 cameras (2026-12-07): 6.1 % pooled, the worst frame +4.8 %; before its ambiguous
 // two-view starts went back to the input (SweepOptions::min_uniqueness) -6.9 %, the worst -7.7 %.
+// Three cameras have no pair nearer than 120 degrees, where two views' agreement is no evidence
+// (VisibilityOptions::max_pair_angle_deg; 2026-12-08): no vertex is refined with confidence, and
+// the printed skirt on 3 cameras ends +0.2 % in every frame (before: -0.3 % pooled, -0.7 % in
+// frame 0), the plain skirt +0.6 %, the smoothed one +2.5 %.
 TEST(QualityTest, SparseRigsEndNoWorseThanTheirInput) {
   struct Rig {
     const char* name;
@@ -154,9 +158,10 @@ TEST(QualityTest, SparseRigsEndNoWorseThanTheirInput) {
     const char* synth_settings;  // Beside the camera count.
   };
   for (const Rig& rig :
-       {Rig{"skirt_3", "synth_skirt.yaml", 3, 0.0, 0.3, ""},
+       {Rig{"skirt_3", "synth_skirt.yaml", 3, 0.0, 0.05, ""},
         Rig{"skirt_4", "synth_skirt.yaml", 4, 0.096, 0.7, ""},  // Margin 5 points.
-        Rig{"smoothed_3", "synth_skirt_smoothed.yaml", 3, 0.0, 0.3, ""},
+        Rig{"smoothed_3", "synth_skirt_smoothed.yaml", 3, 0.0, 0.05, ""},
+        Rig{"printed_3", "synth_skirt.yaml", 3, 0.0, 0.05, ",synth.texture.pattern=print"},
         Rig{"printed_4", "synth_skirt.yaml", 4, 0.0, 0.7, ",synth.texture.pattern=print"}}) {
     SCOPED_TRACE(std::string(rig.name) + " cameras");
     const std::vector<YAML::Node> records =

@@ -32,6 +32,18 @@ struct VisibilityOptions {
   // vertices have one camera within 60 degrees). Evidence from steep views is weaker, and the
   // view confidence (ViewConfidence) says how much weaker. At least max_view_angle_deg.
   double fallback_view_angle_deg = 85.0;
+  // Two cameras far apart see a point from opposite sides of its normal, each steeply: a fold's
+  // flank that faces one of them turns away from the other, and a patch's two images differ by
+  // more than its shape can explain. Their agreement then has rival minima a texture's period
+  // apart. Two views of a synthetic fold 45 degrees apart recover it to 3.7 mm, 90 degrees apart to
+  // 7.7 mm (true 8.4 mm); a ring of three cameras (every pair 120 degrees apart) made a printed
+  // skirt worse than its input, where four (90 degrees) recover 17 % of the skirt's detail
+  // (docs/measurements.md, 2026-12-08). So a vertex's view confidence also asks that two of its
+  // cameras be within max_pair_angle_deg of each other, falling to nothing at
+  // fallback_pair_angle_deg: a ring of four keeps its pairs (90 degrees apart, some more where one
+  // camera stands higher than the other), a ring of three (120 degrees) has none.
+  double max_pair_angle_deg = 105.0;
+  double fallback_pair_angle_deg = 120.0;
   // The detail stage (ConsensusOptions::sample_spacing above 0) reads a patch's samples at the
   // images' own resolution, so a steep view is modelled as the camera sees it, foreshortened,
   // where a surface Gaussian several pixel footprints wide smears it; and it chooses its cameras
@@ -73,7 +85,10 @@ void KeepMostFrontalViews(const std::vector<Camera>& cameras, const Eigen::Matri
 // How well `wanted` cameras see each point, in [0, 1], from the cameras `visible` says see it: 1
 // when the wanted-th most frontal of them is within options.max_view_angle_deg, falling linearly
 // in the cosine of its angle to 0 at options.fallback_view_angle_deg; 0 when fewer than `wanted`
-// see it. `wanted` >= 1.
+// see it. With `wanted` >= 2 it is multiplied by how close the narrowest pair of those cameras is:
+// 1 when two of them are within options.max_pair_angle_deg of each other (the angle between their
+// directions to the point), falling linearly in the cosine to 0 at
+// options.fallback_pair_angle_deg. `wanted` >= 1.
 std::vector<float> ViewConfidence(const std::vector<Camera>& cameras,
                                   const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
                                   int wanted, const VisibilityOptions& options,
