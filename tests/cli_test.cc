@@ -81,13 +81,14 @@ TEST(CliTest, UnknownConfigKeyNamesFileAndKey) {
 }
 
 // A 3-camera synthetic capture of 96 x 96 pixels, one frame, made by `finecap synth`.
-fs::path TinyCapture(const std::string& name) {
+fs::path TinyCapture(const std::string& name, int cameras = 3) {
   const fs::path capture = FreshFolder(name) / "capture";
   const RunResult result =
       RunFinecap("synth --out " + capture.string() +
                  " --set synth.num_frames=1,synth.skirt.around=16,synth.skirt.down=8,"
-                 "synth.texture.width=256,synth.texture.height=128,synth.cameras.count=3,"
-                 "synth.cameras.width=96,synth.cameras.height=96,synth.cameras.focal=300,"
+                 "synth.texture.width=256,synth.texture.height=128,synth.cameras.count=" +
+                 std::to_string(cameras) +
+                 ",synth.cameras.width=96,synth.cameras.height=96,synth.cameras.focal=300,"
                  "synth.render.supersampling=1");
   EXPECT_EQ(result.exit_code, 0) << result.output;
   return capture;
@@ -246,6 +247,25 @@ TEST(CliTest, InfoWarnsAboutVerticesNoCameraSees) {
   EXPECT_NE(result.output.find("seen by no camera within visibility.fallback_view_angle_deg 2"),
             std::string::npos)
       << result.output;
+}
+
+// Before a run, info says how much of the surface its cameras let be refined with confidence,
+// and warns when that is less than half: three cameras on a ring, 120 degrees apart, see no point
+// from two directions near enough to each other; eight, 45 degrees apart, see every one.
+TEST(CliTest, InfoWarnsWhenTheCamerasAreTooFewToRefineUsefully) {
+  const std::string warning = "warning: too few views for this capture to be refined usefully";
+  const RunResult three = RunFinecap("info --capture " + TinyCapture("info_three").string());
+  EXPECT_EQ(three.exit_code, 0) << three.output;
+  EXPECT_NE(three.output.find(", 0 seen well enough by enough cameras"), std::string::npos)
+      << three.output;
+  EXPECT_NE(three.output.find(warning), std::string::npos) << three.output;
+
+  const RunResult eight = RunFinecap("info --capture " + TinyCapture("info_eight", 8).string());
+  EXPECT_EQ(eight.exit_code, 0) << eight.output;
+  const long refined = NumberAfter(eight.output, "vertices refined: ");
+  EXPECT_GT(refined, 0) << eight.output;
+  EXPECT_EQ(NumberAfter(eight.output, "seen by no camera, "), refined) << eight.output;
+  EXPECT_EQ(eight.output.find(warning), std::string::npos) << eight.output;
 }
 
 // Without --out the probe writes into a new folder under $TMPDIR, and nothing into the folder it

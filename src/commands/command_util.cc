@@ -95,6 +95,12 @@ std::string WidestRangeForecast(const ProblemSize& size) {
          LengthText(size.widest_k_max) + ")";
 }
 
+std::string TooFewViewsReason(double share) {
+  return "only " + std::to_string(std::lround(100.0 * share)) +
+         " % of its surface is seen well enough by enough cameras near enough to each other "
+         "(visibility.*, energy.consensus.min_cameras)";
+}
+
 std::string RoundedSeconds(double seconds) {
   std::ostringstream text;
   text.precision(seconds < 10.0 || (seconds >= 60.0 && seconds < 600.0) ? 1 : 0);
@@ -224,10 +230,6 @@ class ConsoleObserver : public SequenceObserver {
   Progress progress_;
 };
 
-// Below this share of vertices refined with confidence, a run says that its capture cannot be
-// refined usefully: most of the surface then stays near the input, for want of views.
-constexpr double kUsefulConfidentShare = 0.5;
-
 void PrintConfidence(double confident_share) {
   if (!std::isfinite(confident_share)) return;
   const long percent = std::lround(100.0 * confident_share);
@@ -235,10 +237,8 @@ void PrintConfidence(double confident_share) {
             << " % of the refined vertices (mean over the frames run now); the rest, seen by too "
                "few cameras, only at steep angles, or plain, stay near the input\n";
   if (confident_share < kUsefulConfidentShare) {
-    std::cout << "Too few views for this capture to be refined usefully: only " << percent
-              << " % of its surface is seen well enough by enough cameras near enough to each "
-                 "other (visibility.*, energy.consensus.min_cameras); the rest is kept near the "
-                 "input\n";
+    std::cout << "Too few views for this capture to be refined usefully: "
+              << TooFewViewsReason(confident_share) << "; the rest is kept near the input\n";
   }
 }
 

@@ -44,6 +44,14 @@ std::string RefinedRunFolder(const Config& config);
 Config WithSceneLengths(const Config& config, const Capture& capture, const std::string& command,
                         SceneScaleDefaults* defaults = nullptr);
 
+// Below this share of vertices refined with confidence (or, before a run, of vertices that its
+// cameras alone let be: ProblemSize::num_well_seen_refined_vertices) a capture cannot be refined
+// usefully: most of the surface then stays near the input, for want of views.
+constexpr double kUsefulConfidentShare = 0.5;
+// Why a capture with only `share` of its surface refined with confidence is not refined usefully:
+// "only N % of its surface is seen well enough ...", naming the keys that decide it.
+std::string TooFewViewsReason(double share);
+
 // A count for people: "8100", "1.2 M", "85 M".
 std::string RoundedCount(double count);
 // A duration for people: "0.8 s", "12 s", "3.5 min".

@@ -57,6 +57,14 @@ void PrintWarnings(const Config& config, const std::vector<Camera>& training,
               << (fallback ? visibility.fallback_view_angle_deg : visibility.max_view_angle_deg)
               << " degrees; they keep the input surface\n";
   }
+  if (size.num_refined_vertices == 0) return;
+  const double well_seen =
+      static_cast<double>(size.num_well_seen_refined_vertices) / size.num_refined_vertices;
+  if (well_seen < internal::kUsefulConfidentShare) {
+    std::cout << "warning: too few views for this capture to be refined usefully: "
+              << internal::TooFewViewsReason(well_seen) << "; refine would keep the rest near "
+              << "the input\n";
+  }
 }
 
 }  // namespace
@@ -105,7 +113,9 @@ int RunInfo(const Config& configured) {
   std::cout << "vertices refined: " << size.num_surface_gaussians << " of "
             << size.num_refined_vertices << " to refine ("
             << (capture.has_vertex_mask() ? "mask.txt" : "no mask: all") << "), "
-            << size.num_unseen_refined_vertices << " seen by no camera\n";
+            << size.num_unseen_refined_vertices << " seen by no camera, "
+            << size.num_well_seen_refined_vertices
+            << " seen well enough by enough cameras to be refined with confidence where textured\n";
   std::cout << "problem per frame: " << size.num_image_gaussians << " image Gaussians, about "
             << internal::RoundedCount(size.num_pairs) << " pairs of Gaussians, "
             << size.num_observations << " observations\n";

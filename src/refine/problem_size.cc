@@ -205,10 +205,13 @@ ProblemSize EstimateProblemSize(const SequenceModel& model, const ReferenceColor
                                               FallbackCamerasWanted(options), frame.masks);
   size.num_fine_vertices = fine.num_vertices();
   size.num_refined_vertices = static_cast<int>(model.refined_vertices().size());
+  const std::vector<float> view_confidence = ViewConfidence(
+      frame.cameras, fine.vertices, normals, CamerasWanted(options), options.visibility, visible);
   for (int v : model.refined_vertices()) {
     bool seen = false;
     for (const auto& camera : visible) seen = seen || camera[v];
     size.num_unseen_refined_vertices += seen ? 0 : 1;
+    size.num_well_seen_refined_vertices += view_confidence[v] >= kConfidentAt ? 1 : 0;
   }
   for (const auto& camera : visible) {
     size.visible_per_camera.push_back(

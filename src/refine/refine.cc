@@ -705,7 +705,7 @@ double ConfidentShare(const FrameResult& result) {
   for (double confidence : result.confidence) {
     if (std::isnan(confidence)) continue;
     ++refined;
-    confident += confidence >= 0.5;
+    confident += confidence >= kConfidentAt;
   }
   return refined > 0 ? static_cast<double>(confident) / refined : std::nan("");
 }

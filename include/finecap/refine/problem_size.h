@@ -37,6 +37,11 @@ struct ProblemSize {
   // Refined vertices that no camera sees (ComputeFrameVisibility, within the fallback view
   // angle where the similarity takes one): they keep the input surface.
   int num_unseen_refined_vertices = 0;
+  // Refined vertices whose cameras alone would let them be refined with confidence: a view
+  // confidence (ViewConfidence: enough cameras, at what angles, near enough to each other) of at
+  // least kConfidentAt. The texture can only lower a vertex's confidence further, so fewer than
+  // half of them means a capture too sparse to be refined usefully, whatever it shows.
+  int num_well_seen_refined_vertices = 0;
   // Per camera, the fine vertices it sees (refined or not): 0 marks a camera that sees nothing.
   std::vector<int> visible_per_camera;
   long num_image_gaussians = 0;  // Over every camera.

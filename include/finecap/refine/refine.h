@@ -358,8 +358,12 @@ int SmoothingRoundsAt(const RefineOptions& options, int rounds);
 // to EnergyOptions::kLargestKMax; energy.k_max where the sweep does not widen.
 double WidestSearchRange(const RefineOptions& options);
 
+// A vertex whose confidence (FrameResult::confidence) is at least this is refined with
+// confidence: the images decide it more than the pull towards the input does.
+constexpr double kConfidentAt = 0.5;
+
 // The share of the refined vertices of `result` refined with confidence (FrameResult::confidence
-// at least 1/2), in [0, 1]; NaN when none was refined.
+// at least kConfidentAt), in [0, 1]; NaN when none was refined.
 double ConfidentShare(const FrameResult& result);
 
 // What bias compensation adds along the normal to every solved displacement of a frame that was
